@@ -1,0 +1,63 @@
+// softrast/framebuffer.hpp: the render target: RGBA8 colour and float32 depth.
+// Row 0 is the top row (window y grows downwards), the same as Image.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "softrast/image.hpp"
+#include "softrast/status.hpp"
+
+namespace softrast {
+
+class Framebuffer {
+ public:
+  // Precondition: 1 <= width, height <= kMaxImageSize (see create() for checked construction).
+  Framebuffer(int width, int height);
+  // Checked construction: an error for sizes outside [1, kMaxImageSize].
+  static Result<Framebuffer> create(int width, int height);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+  // Clears colour (floats clamped to [0, 1]) and depth; the defaults are CONVENTIONS.md's.
+  void clear_color(glm::vec4 color = {0.1f, 0.1f, 0.1f, 1.0f});
+  void clear_depth(float depth = 1.0f);
+  void clear() { clear_color(); clear_depth(); }
+
+  // Packed RGBA8 pixel: byte 0 is red (little-endian uint32 = 0xAABBGGRR).
+  uint32_t* color_row(int y) { return &color_[size_t(y) * size_t(width_)]; }
+  const uint32_t* color_row(int y) const { return &color_[size_t(y) * size_t(width_)]; }
+  float* depth_row(int y) { return &depth_[size_t(y) * size_t(width_)]; }
+  const float* depth_row(int y) const { return &depth_[size_t(y) * size_t(width_)]; }
+  uint32_t color_at(int x, int y) const { return color_row(y)[x]; }
+  float depth_at(int x, int y) const { return depth_row(y)[x]; }
+
+  Image to_image() const;
+
+ private:
+  int width_;
+  int height_;
+  std::vector<uint32_t> color_;
+  std::vector<float> depth_;
+};
+
+// Float colour to RGBA8 by the conventions: clamp to [0, 1], then x * 255 + 0.5 truncated.
+inline uint8_t to_unorm8(float x) {
+  if (!(x > 0.0f)) return 0;  // also maps NaN to 0
+  if (x >= 1.0f) return 255;
+  return static_cast<uint8_t>(x * 255.0f + 0.5f);
+}
+inline uint32_t pack_rgba8(glm::vec4 c) {
+  return uint32_t(to_unorm8(c.r)) | uint32_t(to_unorm8(c.g)) << 8 | uint32_t(to_unorm8(c.b)) << 16 |
+         uint32_t(to_unorm8(c.a)) << 24;
+}
+inline glm::vec4 unpack_rgba8(uint32_t p) {
+  constexpr float k = 1.0f / 255.0f;
+  return {float(p & 0xff) * k, float((p >> 8) & 0xff) * k, float((p >> 16) & 0xff) * k,
+          float(p >> 24) * k};
+}
+
+}  // namespace softrast

@@ -1,0 +1,43 @@
+// softrast/image.hpp: RGBA8 images in memory and their files (PNG, TGA, JPG in; PNG, TGA out).
+// Row 0 is the top row of the picture, as in the files; nothing here flips.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "softrast/status.hpp"
+
+namespace softrast {
+
+// Largest width or height accepted anywhere (images, textures, framebuffers). 16384 keeps every
+// window coordinate inside the fixed-point range with a wide guard band (see raster/fixed_point).
+inline constexpr int kMaxImageSize = 16384;
+
+// An 8-bit RGBA image, rows top to bottom, 4 bytes per pixel, no padding.
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<uint8_t> rgba;  // width * height * 4 bytes
+
+  Image() = default;
+  Image(int w, int h) : width(w), height(h), rgba(size_t(w) * size_t(h) * 4, 0) {}
+  uint8_t* pixel(int x, int y) { return &rgba[(size_t(y) * size_t(width) + size_t(x)) * 4]; }
+  const uint8_t* pixel(int x, int y) const {
+    return &rgba[(size_t(y) * size_t(width) + size_t(x)) * 4];
+  }
+};
+
+// Reads a PNG, TGA (bottom-up or top-down rows), JPG or BMP file into RGBA8, top row first.
+// Errors name the file: missing, unreadable, not an image, or larger than kMaxImageSize.
+Result<Image> load_image(const std::string& path);
+
+// Decodes an image held in memory (same formats as load_image); `name` is used in messages.
+Result<Image> decode_image(const uint8_t* data, size_t size, const std::string& name);
+
+// Writes `image` as PNG or TGA, chosen by the extension of `path` (.png, .tga; case-insensitive).
+// The file appears complete or not at all: the data goes to a temporary file in the same folder
+// that is renamed over `path` only after a successful write.
+Status save_image(const std::string& path, const Image& image);
+
+}  // namespace softrast

@@ -1,0 +1,29 @@
+// softrast/render_state.hpp: the fixed-function state of a draw: culling, depth, blending and
+// the choice of rasterization algorithm. Plain values; every combination is valid.
+#pragma once
+
+namespace softrast {
+
+enum class Primitive { kTriangles, kLines, kPoints };
+enum class CullMode { kNone, kBack, kFront };
+// Which winding, as seen in the image, is front-facing (OpenGL's default is counter-clockwise).
+enum class FrontFace { kCounterClockwise, kClockwise };
+enum class DepthFunc { kNever, kLess, kEqual, kLessEqual, kGreater, kNotEqual, kGreaterEqual, kAlways };
+// kOpaque writes the source; kAlpha is "over" (src * a + dst * (1 - a)); kAdditive is src + dst.
+enum class BlendMode { kOpaque, kAlpha, kAdditive };
+// Two triangle rasterizers with identical coverage: edge equations over tiles (the default) and
+// edge walking over scanlines (a second, independent implementation of the same rules).
+enum class RasterAlgorithm { kEdgeEquations, kScanline };
+
+struct RenderState {
+  Primitive primitive = Primitive::kTriangles;
+  CullMode cull = CullMode::kBack;
+  FrontFace front_face = FrontFace::kCounterClockwise;
+  bool depth_test = true;  // false: every fragment passes and depth is not written
+  DepthFunc depth_func = DepthFunc::kLess;
+  bool depth_write = true;
+  BlendMode blend = BlendMode::kOpaque;
+  RasterAlgorithm raster = RasterAlgorithm::kEdgeEquations;
+};
+
+}  // namespace softrast
