@@ -1,0 +1,172 @@
+// io/image_io.cpp: image files in and out through stb_image and stb_image_write.
+// Decoding always asks stb for RGBA8; saving goes through a temporary file and a rename.
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cerrno>
+#include <climits>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <stb_image.h>
+#include <stb_image_write.h>
+
+#include "softrast/image.hpp"
+
+namespace softrast {
+namespace {
+
+Status fail(const std::string& path, const std::string& reason) {
+  return Status::error(path + ": " + reason);
+}
+
+std::string errno_text() {
+  return std::strerror(errno);
+}
+
+bool valid_size(int width, int height) {
+  return width > 0 && height > 0 && width <= kMaxImageSize && height <= kMaxImageSize;
+}
+
+std::string size_text(int width, int height) {
+  return std::to_string(width) + "x" + std::to_string(height);
+}
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
+
+// Reads the whole file; fails on open or read errors (including "is a directory").
+Status read_file(const std::string& path, std::vector<uint8_t>& bytes) {
+  FilePtr f(std::fopen(path.c_str(), "rb"));
+  if (!f) return fail(path, "cannot open: " + errno_text());
+  uint8_t buffer[1 << 16];
+  size_t n;
+  while ((n = std::fread(buffer, 1, sizeof buffer, f.get())) > 0) {
+    bytes.insert(bytes.end(), buffer, buffer + n);
+  }
+  if (std::ferror(f.get())) return fail(path, "cannot read: " + errno_text());
+  return {};
+}
+
+enum class Format { kUnknown, kPng, kTga };
+
+Format format_of(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext == ".png") return Format::kPng;
+  if (ext == ".tga") return Format::kTga;
+  return Format::kUnknown;
+}
+
+void append_bytes(void* context, void* data, int size) {
+  auto* out = static_cast<std::vector<uint8_t>*>(context);
+  const auto* bytes = static_cast<const uint8_t*>(data);
+  out->insert(out->end(), bytes, bytes + size);
+}
+
+// Encodes into memory; stb reports failure (e.g. out of memory) by returning 0.
+bool encode(Format format, const Image& image, std::vector<uint8_t>& out) {
+  if (format == Format::kPng) {
+    return stbi_write_png_to_func(append_bytes, &out, image.width, image.height, 4,
+                                  image.rgba.data(), image.width * 4) != 0;
+  }
+  return stbi_write_tga_to_func(append_bytes, &out, image.width, image.height, 4,
+                                image.rgba.data()) != 0;
+}
+
+// A name no other writer uses: the pid separates processes, the counter threads of this one.
+std::string temporary_name(const std::string& path) {
+  static std::atomic<unsigned> counter{0};
+  return path + ".tmp." + std::to_string(getpid()) + "." + std::to_string(counter++);
+}
+
+// Writes all of `bytes` to a new file, flushed to the disk before it is closed; on failure removes
+// it and says why. "x" refuses an existing file, so a stale temporary is never reused.
+bool write_new_file(const std::string& path, const std::vector<uint8_t>& bytes,
+                    std::string& reason) {
+  std::FILE* f = std::fopen(path.c_str(), "wbx");
+  if (!f) {
+    reason = errno_text();
+    return false;
+  }
+  bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+  ok = ok && std::fflush(f) == 0 && fsync(fileno(f)) == 0;
+  if (!ok) reason = errno_text();
+  if (std::fclose(f) != 0 && ok) {
+    ok = false;
+    reason = errno_text();
+  }
+  if (!ok) std::remove(path.c_str());
+  return ok;
+}
+
+// stb keeps its last failure per thread; it is a short phrase such as "bad png sig".
+std::string stb_reason() {
+  const char* reason = stbi_failure_reason();
+  return reason ? reason : "unknown error";
+}
+
+}  // namespace
+
+Result<Image> decode_image(const uint8_t* data, size_t size, const std::string& name) {
+  if (size == 0) return fail(name, "empty file");
+  if (size > size_t(INT_MAX)) return fail(name, "file too large to decode");
+  // stbi_info reads only the header, so absurd sizes are refused before any allocation.
+  int width = 0, height = 0, channels = 0;
+  if (!stbi_info_from_memory(data, int(size), &width, &height, &channels)) {
+    return fail(name, "not a readable image (" + stb_reason() + ")");
+  }
+  if (!valid_size(width, height)) {
+    return fail(name, "image size " + size_text(width, height) + " is outside 1.." +
+                          std::to_string(kMaxImageSize));
+  }
+  uint8_t* pixels = stbi_load_from_memory(data, int(size), &width, &height, &channels, 4);
+  if (!pixels) {
+    return fail(name, "cannot decode image (" + stb_reason() + ")");
+  }
+  std::unique_ptr<uint8_t, void (*)(void*)> owner(pixels, stbi_image_free);
+  if (!valid_size(width, height)) return fail(name, "image size changed while decoding");
+  Image image(width, height);
+  std::copy(pixels, pixels + image.rgba.size(), image.rgba.begin());
+  return image;
+}
+
+Result<Image> load_image(const std::string& path) {
+  std::vector<uint8_t> bytes;
+  if (Status s = read_file(path, bytes); !s.ok()) return s;
+  return decode_image(bytes.data(), bytes.size(), path);
+}
+
+Status save_image(const std::string& path, const Image& image) {
+  Format format = format_of(path);
+  if (format == Format::kUnknown) return fail(path, "unknown image extension (use .png or .tga)");
+  if (!valid_size(image.width, image.height) ||
+      image.rgba.size() != size_t(image.width) * size_t(image.height) * 4) {
+    return fail(path, "invalid image " + size_text(image.width, image.height) + " with " +
+                          std::to_string(image.rgba.size()) + " bytes");
+  }
+  std::vector<uint8_t> bytes;
+  if (!encode(format, image, bytes)) return fail(path, "cannot encode image");
+  std::string temporary = temporary_name(path);
+  if (std::string reason; !write_new_file(temporary, bytes, reason)) {
+    return fail(path, "cannot write: " + reason);
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    std::string reason = errno_text();
+    std::remove(temporary.c_str());
+    return fail(path, "cannot replace file: " + reason);
+  }
+  return {};
+}
+
+}  // namespace softrast
