@@ -25,7 +25,10 @@ class Framebuffer {
   // Clears colour (floats clamped to [0, 1]) and depth; the defaults are CONVENTIONS.md's.
   void clear_color(glm::vec4 color = {0.1f, 0.1f, 0.1f, 1.0f});
   void clear_depth(float depth = 1.0f);
-  void clear() { clear_color(); clear_depth(); }
+  void clear() {
+    clear_color();
+    clear_depth();
+  }
 
   // Packed RGBA8 pixel: byte 0 is red (little-endian uint32 = 0xAABBGGRR).
   uint32_t* color_row(int y) { return &color_[size_t(y) * size_t(width_)]; }

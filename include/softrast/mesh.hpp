@@ -17,7 +17,7 @@ namespace softrast {
 
 struct Material {
   std::string name;
-  glm::vec3 diffuse{0.9f, 0.6f, 0.3f};       // Kd; the default is SCENES.md's albedo A
+  glm::vec3 diffuse{0.9f, 0.6f, 0.3f};         // Kd; the default is SCENES.md's albedo A
   std::shared_ptr<const Texture> diffuse_map;  // map_Kd, or null
 };
 
@@ -34,7 +34,7 @@ struct Mesh {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
   std::vector<glm::vec2> uvs;
-  std::vector<uint32_t> indices;  // three per triangle
+  std::vector<uint32_t> indices;   // three per triangle
   std::vector<SubMesh> submeshes;  // cover `indices`; empty means one run with material -1
   std::vector<Material> materials;
 

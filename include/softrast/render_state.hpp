@@ -8,7 +8,16 @@ enum class Primitive { kTriangles, kLines, kPoints };
 enum class CullMode { kNone, kBack, kFront };
 // Which winding, as seen in the image, is front-facing (OpenGL's default is counter-clockwise).
 enum class FrontFace { kCounterClockwise, kClockwise };
-enum class DepthFunc { kNever, kLess, kEqual, kLessEqual, kGreater, kNotEqual, kGreaterEqual, kAlways };
+enum class DepthFunc {
+  kNever,
+  kLess,
+  kEqual,
+  kLessEqual,
+  kGreater,
+  kNotEqual,
+  kGreaterEqual,
+  kAlways
+};
 // kOpaque writes the source; kAlpha is "over" (src * a + dst * (1 - a)); kAdditive is src + dst.
 enum class BlendMode { kOpaque, kAlpha, kAdditive };
 // Two triangle rasterizers with identical coverage: edge equations over tiles (the default) and
@@ -24,6 +33,11 @@ struct RenderState {
   bool depth_write = true;
   BlendMode blend = BlendMode::kOpaque;
   RasterAlgorithm raster = RasterAlgorithm::kEdgeEquations;
+  // Triangles drawn as their three edges (glPolygonMode GL_LINE), after culling.
+  bool wireframe = false;
+  // Added to every window depth before the depth test (like a polygon offset in depth units);
+  // a small negative value lets a wireframe overlay win against its own filled surface.
+  float depth_bias = 0.0f;
 };
 
 }  // namespace softrast

@@ -1,0 +1,61 @@
+// softrast/renderer.hpp: the high-level API: draw a Mesh through a Camera with one of the
+// built-in shaders. For your own shaders, see softrast/shader.hpp.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string_view>
+
+#include <glm/vec3.hpp>
+
+#include "softrast/camera.hpp"
+#include "softrast/framebuffer.hpp"
+#include "softrast/mesh.hpp"
+#include "softrast/render_state.hpp"
+#include "softrast/texture.hpp"
+
+namespace softrast {
+
+// The built-in shaders. flat, gouraud, texture and phong follow ../shared/bench/SCENES.md
+// exactly (light direction, albedo, ambient 0.15, diffuse 0.85, specular 0.4, shininess 32).
+enum class ShaderKind {
+  kFlat,       // the albedo, unlit
+  kGouraud,    // Lambert per vertex, colour interpolated
+  kTexture,    // the texture at the interpolated uv
+  kPhong,      // Blinn-Phong per pixel, albedo from the texture when there is one
+  kNormals,    // debug: the normal as colour, n * 0.5 + 0.5
+  kDepth,      // debug: linear view depth as grey, white at the near plane
+  kWireframe,  // triangle edges in the wire colour, after culling
+};
+std::optional<ShaderKind> parse_shader_kind(std::string_view name);
+const char* shader_kind_name(ShaderKind kind);
+
+struct RenderOptions {
+  ShaderKind shader = ShaderKind::kPhong;
+  RenderState state;
+  // Albedo for flat, gouraud and untextured phong when the mesh has no material of its own.
+  glm::vec3 color{0.9f, 0.6f, 0.3f};
+  float alpha = 1.0f;  // output alpha of every shader (times the texture's alpha)
+  // Overrides the materials' diffuse maps for texture and phong when set.
+  std::shared_ptr<const Texture> texture;
+  Sampler sampler;
+  glm::vec3 light_direction{0.3f, 0.5f, 0.8f};  // towards the light, world space; normalised
+  // Draws the culled triangle edges over the shaded mesh as well (hidden edges stay hidden).
+  bool wireframe_overlay = false;
+  glm::vec3 wire_color{0.05f, 0.05f, 0.05f};
+};
+
+// Draws `mesh` (positions in world space) seen by `camera` into `framebuffer`, which is not
+// cleared first. The aspect ratio is the framebuffer's.
+void render_mesh(Framebuffer& framebuffer, const Mesh& mesh, const Camera& camera,
+                 const RenderOptions& options);
+
+// The built-in demo scene: textured, lit objects on a large floor that crosses the near plane
+// and the image border, and the camera to look at it with.
+struct DemoScene {
+  Mesh mesh;
+  Camera camera;
+};
+DemoScene make_demo_scene();
+
+}  // namespace softrast

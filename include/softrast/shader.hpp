@@ -1,0 +1,58 @@
+// softrast/shader.hpp: programmable shaders. Opt in to this header to draw with your own vertex
+// and fragment shader; it compiles the fragment stage for your shader type (no virtual calls).
+//
+// A shader is any type with:
+//   static constexpr int kVaryings = N;               // 0..16 floats from vertex to fragment
+//   glm::vec4 vertex(uint32_t index, float* varyings) const;   // clip-space position; writes N
+//   bool fragment(FragmentInput& in, glm::vec4& color) const;  // false discards the pixel
+// and optionally `static constexpr bool kWritesDepth = true;` when fragment() sets in.depth
+// (this turns the early depth test into a late one).
+//
+// The vertex shader pulls its own inputs by index (from whatever arrays the shader holds), so
+// any vertex layout works. Varyings are interpolated perspective-correctly.
+#pragma once
+
+#include <concepts>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "softrast/detail/interpolants.hpp"
+#include "softrast/detail/shade_block.hpp"
+#include "softrast/framebuffer.hpp"
+#include "softrast/render_state.hpp"
+
+namespace softrast {
+
+inline constexpr int kMaxVaryings = detail::kMaxVaryings;
+
+template <class S>
+concept ShaderProgram = requires(const S& s, uint32_t index, float* out, FragmentInput& in,
+                                 glm::vec4& color) {
+  requires S::kVaryings >= 0 && S::kVaryings <= kMaxVaryings;
+  { s.vertex(index, out) } -> std::convertible_to<glm::vec4>;
+  { s.fragment(in, color) } -> std::convertible_to<bool>;
+};
+
+// Draws `indices` (three per triangle, two per line, one per point, as state.primitive says)
+// over vertices 0..vertex_count-1 into `framebuffer`. Runs the vertex shader once per vertex,
+// then clipping, culling, rasterization, depth test, the fragment shader and blending. Indices
+// >= vertex_count skip their primitive; primitives with NaN or Inf positions draw nothing.
+template <ShaderProgram S>
+void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
+          std::span<const uint32_t> indices, uint32_t vertex_count) {
+  constexpr int kStride = 4 + S::kVaryings;
+  std::vector<float> clip(size_t(vertex_count) * kStride);
+  for (uint32_t i = 0; i < vertex_count; ++i) {
+    float* v = &clip[size_t(i) * kStride];
+    glm::vec4 p = shader.vertex(i, v + 4);
+    v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = p.w;
+  }
+  detail::ClipVertices vertices{clip.data(), vertex_count, kStride, S::kVaryings};
+  detail::FragmentProgram program{&detail::shade_block<S>, &shader};
+  detail::draw_clip_space(framebuffer, state, vertices, indices.data(), indices.size(), program);
+}
+
+}  // namespace softrast

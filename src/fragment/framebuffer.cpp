@@ -1,0 +1,45 @@
+// fragment/framebuffer.cpp
+#include "softrast/framebuffer.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+namespace softrast {
+
+Framebuffer::Framebuffer(int width, int height)
+    : width_(width),
+      height_(height),
+      color_(size_t(width) * size_t(height)),
+      depth_(size_t(width) * size_t(height)) {
+  clear();
+}
+
+Result<Framebuffer> Framebuffer::create(int width, int height) {
+  if (width < 1 || height < 1 || width > kMaxImageSize || height > kMaxImageSize) {
+    return Status::error("image size " + std::to_string(width) + "x" + std::to_string(height) +
+                         " is outside 1x1 .. " + std::to_string(kMaxImageSize) + "x" +
+                         std::to_string(kMaxImageSize));
+  }
+  return Framebuffer(width, height);
+}
+
+void Framebuffer::clear_color(glm::vec4 color) {
+  std::fill(color_.begin(), color_.end(), pack_rgba8(color));
+}
+
+void Framebuffer::clear_depth(float depth) {
+  std::fill(depth_.begin(), depth_.end(), depth);
+}
+
+Image Framebuffer::to_image() const {
+  Image image(width_, height_);
+  for (size_t i = 0; i < color_.size(); ++i) {
+    uint32_t p = color_[i];
+    uint8_t* out = &image.rgba[i * 4];
+    out[0] = uint8_t(p), out[1] = uint8_t(p >> 8), out[2] = uint8_t(p >> 16),
+    out[3] = uint8_t(p >> 24);
+  }
+  return image;
+}
+
+}  // namespace softrast

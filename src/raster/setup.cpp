@@ -1,0 +1,175 @@
+// raster/setup.cpp: edge functions, fill-rule bias, bounds and plane equations.
+#include "raster/setup.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <utility>
+
+namespace softrast::detail {
+namespace {
+
+// Top-left rule in y-down window coordinates for a clockwise triangle: a left edge runs upwards
+// (dy < 0); a top edge is horizontal and runs to the right (dy == 0, dx > 0).
+bool is_top_left(int64_t dx, int64_t dy) {
+  return dy < 0 || (dy == 0 && dx > 0);
+}
+
+EdgeFunction make_edge(int32_t xi, int32_t yi, int32_t xj, int32_t yj) {
+  // E(p) = (xj - xi)(py - yi) - (yj - yi)(px - xi): positive to the right of i->j in y-down
+  // coordinates, i.e. inside a clockwise triangle.
+  int64_t dx = int64_t(xj) - xi, dy = int64_t(yj) - yi;
+  EdgeFunction e;
+  e.a = -dy;
+  e.b = dx;
+  e.c = dy * xi - dx * yi;
+  if (!is_top_left(dx, dy)) e.c -= 1;  // samples exactly on the edge fail the E >= 0 test
+  return e;
+}
+
+double to_pixels(int32_t fx8) {
+  return double(fx8) / kSubpixelOne;
+}
+
+// The plane through (x_k, y_k, a_k), k = 0..2, referenced at vertex 0. `area2` is twice the
+// signed area in square pixels (non-zero).
+Plane make_plane(const double x[3], const double y[3], const double a[3], double area2) {
+  double da1 = a[1] - a[0], da2 = a[2] - a[0];
+  double dx1 = x[1] - x[0], dx2 = x[2] - x[0];
+  double dy1 = y[1] - y[0], dy2 = y[2] - y[0];
+  Plane p;
+  p.a0 = float(a[0]);
+  p.dadx = float((da1 * dy2 - da2 * dy1) / area2);
+  p.dady = float((da2 * dx1 - da1 * dx2) / area2);
+  return p;
+}
+
+PixelRect triangle_bounds(const int32_t vx[3], const int32_t vy[3]) {
+  int64_t xmin = std::min({vx[0], vx[1], vx[2]}), xmax = std::max({vx[0], vx[1], vx[2]});
+  int64_t ymin = std::min({vy[0], vy[1], vy[2]}), ymax = std::max({vy[0], vy[1], vy[2]});
+  // Pixel i's sample is at 256 i + 128: the first sample at or right of xmin, the last at or
+  // left of xmax.
+  PixelRect r;
+  r.x0 = int(ceil_div(xmin - kSubpixelHalf, kSubpixelOne));
+  r.x1 = int(floor_div(xmax - kSubpixelHalf, kSubpixelOne)) + 1;
+  r.y0 = int(ceil_div(ymin - kSubpixelHalf, kSubpixelOne));
+  r.y1 = int(floor_div(ymax - kSubpixelHalf, kSubpixelOne)) + 1;
+  return r;
+}
+
+// Fills the planes for depth, 1/w and varying/w of the (already reordered) triangle.
+void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area_fx16,
+                  Interpolants& out) {
+  double x[3], y[3], a[3];
+  for (int k = 0; k < 3; ++k) {
+    x[k] = to_pixels(v[k]->x);
+    y[k] = to_pixels(v[k]->y);
+  }
+  double area2 = double(area_fx16) / (double(kSubpixelOne) * kSubpixelOne);
+  out.x_ref = float(x[0]);
+  out.y_ref = float(y[0]);
+  for (int k = 0; k < 3; ++k) a[k] = v[k]->z;
+  out.z = make_plane(x, y, a, area2);
+  for (int k = 0; k < 3; ++k) a[k] = v[k]->inv_w;
+  out.inv_w = make_plane(x, y, a, area2);
+  for (int i = 0; i < num_varyings; ++i) {
+    for (int k = 0; k < 3; ++k) a[k] = double(v[k]->varyings[i]) * v[k]->inv_w;
+    out.var[i] = make_plane(x, y, a, area2);
+  }
+  out.num_varyings = num_varyings;
+}
+
+}  // namespace
+
+PixelRect intersect(const PixelRect& a, const PixelRect& b) {
+  return {std::max(a.x0, b.x0), std::max(a.y0, b.y0), std::min(a.x1, b.x1), std::min(a.y1, b.y1)};
+}
+
+int64_t signed_area_fx16(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2) {
+  return (int64_t(v1.x) - v0.x) * (int64_t(v2.y) - v0.y) -
+         (int64_t(v2.x) - v0.x) * (int64_t(v1.y) - v0.y);
+}
+
+bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
+                    int num_varyings, CullMode cull, FrontFace front_face, const PixelRect& scissor,
+                    TriangleSetup& out) {
+  int64_t area = signed_area_fx16(v0, v1, v2);
+  if (area == 0) return false;  // zero area: back-facing by convention, and covers nothing
+  bool ccw = area < 0;          // counter-clockwise as seen in the image (y down)
+  bool front = (front_face == FrontFace::kCounterClockwise) == ccw;
+  if ((cull == CullMode::kBack && !front) || (cull == CullMode::kFront && front)) return false;
+
+  // Reorder to clockwise so that every edge function is positive inside.
+  const WindowVertex* v[3] = {&v0, &v1, &v2};
+  if (ccw) std::swap(v[1], v[2]);
+  for (int k = 0; k < 3; ++k) {
+    out.vx[k] = v[k]->x;
+    out.vy[k] = v[k]->y;
+  }
+  out.bounds = intersect(triangle_bounds(out.vx, out.vy), scissor);
+  if (out.bounds.empty()) return false;
+  for (int k = 0; k < 3; ++k) {
+    int j = (k + 1) % 3;
+    out.edge[k] = make_edge(out.vx[k], out.vy[k], out.vx[j], out.vy[j]);
+  }
+  setup_planes(v, num_varyings, std::abs(area), out.interp);
+  out.interp.front_facing = front;
+  return true;
+}
+
+bool setup_line(const WindowVertex& v0, const WindowVertex& v1, int num_varyings,
+                const PixelRect& scissor, LineSetup& out) {
+  int64_t dx = int64_t(v1.x) - v0.x, dy = int64_t(v1.y) - v0.y;
+  if (dx == 0 && dy == 0) return false;
+  out.x0 = v0.x;
+  out.y0 = v0.y;
+  out.x1 = v1.x;
+  out.y1 = v1.y;
+  PixelRect box;
+  box.x0 = int(floor_div(std::min(v0.x, v1.x), kSubpixelOne));
+  box.x1 = int(floor_div(std::max(v0.x, v1.x), kSubpixelOne)) + 1;
+  box.y0 = int(floor_div(std::min(v0.y, v1.y), kSubpixelOne));
+  box.y1 = int(floor_div(std::max(v0.y, v1.y), kSubpixelOne)) + 1;
+  out.bounds = intersect(box, scissor);
+  if (out.bounds.empty()) return false;
+
+  // Attributes vary along the major axis only: a(x, y) = a0 + (x - x0) * (a1 - a0) / dx.
+  bool x_major = std::llabs(dx) >= std::llabs(dy);
+  double len = double(x_major ? dx : dy) / kSubpixelOne;
+  auto line_plane = [&](double a0, double a1) {
+    Plane p;
+    p.a0 = float(a0);
+    float g = float((a1 - a0) / len);
+    (x_major ? p.dadx : p.dady) = g;
+    return p;
+  };
+  Interpolants& in = out.interp;
+  in.x_ref = float(to_pixels(v0.x));
+  in.y_ref = float(to_pixels(v0.y));
+  in.z = line_plane(v0.z, v1.z);
+  in.inv_w = line_plane(v0.inv_w, v1.inv_w);
+  for (int i = 0; i < num_varyings; ++i) {
+    in.var[i] = line_plane(double(v0.varyings[i]) * v0.inv_w, double(v1.varyings[i]) * v1.inv_w);
+  }
+  in.num_varyings = num_varyings;
+  in.front_facing = true;
+  return true;
+}
+
+bool setup_point(const WindowVertex& v, int num_varyings, const PixelRect& scissor, int& px,
+                 int& py, Interpolants& out) {
+  px = int(floor_div(v.x, kSubpixelOne));
+  py = int(floor_div(v.y, kSubpixelOne));
+  if (px < scissor.x0 || px >= scissor.x1 || py < scissor.y0 || py >= scissor.y1) return false;
+  out = Interpolants{};
+  out.x_ref = float(to_pixels(v.x));
+  out.y_ref = float(to_pixels(v.y));
+  out.z.a0 = v.z;
+  out.inv_w.a0 = v.inv_w;
+  for (int i = 0; i < num_varyings; ++i) out.var[i].a0 = v.varyings[i] * v.inv_w;
+  out.num_varyings = num_varyings;
+  out.front_facing = true;
+  return true;
+}
+
+}  // namespace softrast::detail
