@@ -24,7 +24,7 @@ enum class ShaderKind {
   kTexture,    // the texture at the interpolated uv
   kPhong,      // Blinn-Phong per pixel, albedo from the texture when there is one
   kNormals,    // debug: the normal as colour, n * 0.5 + 0.5
-  kDepth,      // debug: linear view depth as grey, white at the near plane
+  kDepth,      // debug: near / view depth as grey, white at the near plane
   kWireframe,  // triangle edges in the wire colour, after culling
 };
 std::optional<ShaderKind> parse_shader_kind(std::string_view name);

@@ -116,18 +116,19 @@ struct NormalsShader {
   }
 };
 
-// Grey = 1 - (view depth - near) / (far - near), from the interpolated view-space depth.
+// Grey = near / view depth: white at the near plane, halving with every doubling of distance
+// (a linear ramp to the far plane would leave most scenes a uniform white).
 struct DepthShader {
   static constexpr int kVaryings = 1;
   MeshInputs in;
   glm::mat4 view{1.0f};
-  float near_plane = 0.1f, far_plane = 100.0f;
+  float near_plane = 0.1f;
   glm::vec4 vertex(uint32_t i, float* v) const {
     v[0] = -(view * glm::vec4(in.mesh->positions[i], 1.0f)).z;
     return in.clip(i);
   }
   bool fragment(FragmentInput& f, glm::vec4& out) const {
-    float g = 1.0f - (f.varyings[0] - near_plane) / (far_plane - near_plane);
+    float g = near_plane / std::max(f.varyings[0], near_plane);
     out = glm::vec4(glm::vec3(std::clamp(g, 0.0f, 1.0f)), 1.0f);
     return true;
   }

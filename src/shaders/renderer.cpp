@@ -1,4 +1,5 @@
 // shaders/renderer.cpp: render_mesh, the built-in shaders' entry point.
+#include <algorithm>
 #include <array>
 #include <span>
 #include <string_view>
@@ -63,7 +64,7 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
     case ShaderKind::kNormals:
       return draw(fb, state, NormalsShader{in}, indices, n);
     case ShaderKind::kDepth:
-      return draw(fb, state, DepthShader{in, camera.view(), camera.near_plane, camera.far_plane},
+      return draw(fb, state, DepthShader{in, camera.view(), std::max(camera.near_plane, 1.0e-3f)},
                   indices, n);
   }
 }

@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Installs what softrast needs to build and test on Debian 12, all from Debian's packages.
+set -euo pipefail
+packages=(
+  cmake g++ make pkg-config  # the toolchain
+  libglm-dev                 # vectors and matrices with OpenGL's conventions
+  libtinyobjloader-dev       # OBJ parsing
+  libstb-dev                 # PNG/TGA/JPG decoding, PNG/TGA encoding
+  libcli11-dev               # the command line
+  libgtest-dev               # the test suite
+)
+sudo=""
+if [ "$(id -u)" != 0 ]; then sudo="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${packages[@]}" >/dev/null
+echo "install-deps: ${#packages[@]} packages present"
