@@ -24,8 +24,8 @@ enum class ShaderKind {
   kTexture,    // the texture at the interpolated uv
   kPhong,      // Blinn-Phong per pixel, albedo from the texture when there is one
   kNormals,    // debug: the normal as colour, n * 0.5 + 0.5
-  kDepth,      // debug: near / view depth as grey, white at the near plane
-  kWireframe,  // triangle edges in the wire colour, after culling
+  kDepth,      // debug: view depth as grey on a log scale, white at near, black at far
+  kWireframe,  // triangle edges in the albedo colour, after culling
 };
 std::optional<ShaderKind> parse_shader_kind(std::string_view name);
 const char* shader_kind_name(ShaderKind kind);

@@ -28,10 +28,11 @@ Texture make_texture(int size, const std::function<glm::vec3(float, float)>& f) 
   return Texture::from_image(image);
 }
 
-int add_material(Mesh& mesh, const char* name, Texture texture) {
+// `diffuse` is the material's colour for the untextured shaders (flat, gouraud, wireframe).
+int add_material(Mesh& mesh, const char* name, glm::vec3 diffuse, Texture texture) {
   Material m;
   m.name = name;
-  m.diffuse = glm::vec3(1.0f);
+  m.diffuse = diffuse;
   m.diffuse_map = std::make_shared<const Texture>(std::move(texture));
   mesh.materials.push_back(std::move(m));
   return int(mesh.materials.size()) - 1;
@@ -139,10 +140,10 @@ glm::vec3 rings(float u, float v) {
 DemoScene make_demo_scene() {
   DemoScene scene;
   Mesh& mesh = scene.mesh;
-  int floor_mat = add_material(mesh, "floor", make_texture(256, checker));
-  int stripe_mat = add_material(mesh, "stripes", make_texture(128, stripes));
-  int brick_mat = add_material(mesh, "bricks", make_texture(128, bricks));
-  int ring_mat = add_material(mesh, "rings", make_texture(128, rings));
+  int floor_mat = add_material(mesh, "floor", {0.55f, 0.58f, 0.6f}, make_texture(256, checker));
+  int stripe_mat = add_material(mesh, "stripes", {0.92f, 0.58f, 0.25f}, make_texture(128, stripes));
+  int brick_mat = add_material(mesh, "bricks", {0.65f, 0.3f, 0.22f}, make_texture(128, bricks));
+  int ring_mat = add_material(mesh, "rings", {0.45f, 0.7f, 0.92f}, make_texture(128, rings));
 
   // Floor: y = 0 from z = +12 (behind the camera) to z = -30, 4 x 4 quads so that some triangles
   // straddle the near plane and some lie wholly behind the camera.

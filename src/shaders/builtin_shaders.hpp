@@ -116,19 +116,21 @@ struct NormalsShader {
   }
 };
 
-// Grey = near / view depth: white at the near plane, halving with every doubling of distance
-// (a linear ramp to the far plane would leave most scenes a uniform white).
+// Grey = 1 - log(depth / near) / log(far / near) of the view depth: white at the near plane,
+// black at the far plane, equal steps for equal distance ratios (a linear ramp would leave most
+// scenes a uniform white, as window depth does).
 struct DepthShader {
   static constexpr int kVaryings = 1;
   MeshInputs in;
   glm::mat4 view{1.0f};
   float near_plane = 0.1f;
+  float log_range = 1.0f;  // log(far / near)
   glm::vec4 vertex(uint32_t i, float* v) const {
     v[0] = -(view * glm::vec4(in.mesh->positions[i], 1.0f)).z;
     return in.clip(i);
   }
   bool fragment(FragmentInput& f, glm::vec4& out) const {
-    float g = near_plane / std::max(f.varyings[0], near_plane);
+    float g = 1.0f - std::log(std::max(f.varyings[0], near_plane) / near_plane) / log_range;
     out = glm::vec4(glm::vec3(std::clamp(g, 0.0f, 1.0f)), 1.0f);
     return true;
   }

@@ -1,6 +1,7 @@
 // shaders/renderer.cpp: render_mesh, the built-in shaders' entry point.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <span>
 #include <string_view>
 
@@ -48,8 +49,8 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
   switch (kind) {
     case ShaderKind::kFlat:
       return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, opt.alpha)}, indices, n);
-    case ShaderKind::kWireframe:
-      return draw(fb, state, FlatShader{in, glm::vec4(opt.wire_color, 1.0f)}, indices, n);
+    case ShaderKind::kWireframe:  // the overlay passes the wire colour as the surface albedo
+      return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, 1.0f)}, indices, n);
     case ShaderKind::kGouraud:
       return draw(fb, state, GouraudShader{in, surf.albedo, light, opt.alpha}, indices, n);
     case ShaderKind::kTexture: {
@@ -63,9 +64,11 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
           indices, n);
     case ShaderKind::kNormals:
       return draw(fb, state, NormalsShader{in}, indices, n);
-    case ShaderKind::kDepth:
-      return draw(fb, state, DepthShader{in, camera.view(), std::max(camera.near_plane, 1.0e-3f)},
-                  indices, n);
+    case ShaderKind::kDepth: {
+      float near_plane = std::max(camera.near_plane, 1.0e-3f);
+      float log_range = std::log(std::max(camera.far_plane / near_plane, 1.0f + 1.0e-3f));
+      return draw(fb, state, DepthShader{in, camera.view(), near_plane, log_range}, indices, n);
+    }
   }
 }
 
@@ -120,7 +123,8 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
     wire.depth_func = DepthFunc::kLessEqual;
     wire.depth_bias = -1.0e-4f;
     std::span<const uint32_t> all(mesh.indices);
-    draw_run(framebuffer, wire, mesh, camera, mvp, all, Surface{}, options, ShaderKind::kWireframe);
+    draw_run(framebuffer, wire, mesh, camera, mvp, all, Surface{options.wire_color, nullptr},
+             options, ShaderKind::kWireframe);
   }
 }
 
