@@ -1,0 +1,79 @@
+// apps/softrast/args.cpp: the render command's flags and their help texts. Values are checked
+// later (setup.cpp), so every malformed value gets the same style of message.
+
+#include "args.hpp"
+
+namespace softrast::cli {
+namespace {
+
+void define_output_flags(CLI::App& app, RawArgs& a) {
+  app.add_option("MODEL", a.model,
+                 "Wavefront OBJ file (positions in world space); without it, "
+                 "the built-in demo scene");
+  app.add_option("-o,--out", a.output,
+                 "Output image, .png or .tga (default softrast.png; with --frames, only if given)")
+      ->type_name("PATH");
+  app.add_option("--size", a.size, "Image size (default 800x600)")->type_name("WxH");
+  app.add_option("--frames", a.frames,
+                 "Benchmark: time N frames after 2 warm-up frames, print one JSON line")
+      ->type_name("N");
+  app.add_flag("-q,--quiet", a.quiet, "No progress messages on stderr");
+}
+
+void define_camera_flags(CLI::App& app, RawArgs& a) {
+  app.add_option("--eye", a.eye, "Camera position (default: frame the model from +z)")
+      ->type_name("X,Y,Z");
+  app.add_option("--target", a.target, "Point looked at (default: the model's centre)")
+      ->type_name("X,Y,Z");
+  app.add_option("--up", a.up, "Up direction (default 0,1,0)")->type_name("X,Y,Z");
+  app.add_option("--fov", a.fov, "Vertical field of view in degrees, gluPerspective (default 45)")
+      ->type_name("DEG");
+  app.add_option("--ortho", a.ortho, "Orthographic box (glOrtho) instead of a perspective")
+      ->type_name("L,R,B,T");
+  app.add_option("--near", a.near_plane, "Near plane distance (default: fit the model)")
+      ->type_name("Z");
+  app.add_option("--far", a.far_plane, "Far plane distance (default: fit the model)")
+      ->type_name("Z");
+}
+
+void define_shading_flags(CLI::App& app, RawArgs& a) {
+  app.add_option("--shader", a.shader,
+                 "flat, gouraud, texture, phong, normals, depth or wireframe (default phong)")
+      ->type_name("NAME");
+  app.add_flag("--wireframe", a.wireframe, "Draw the triangle edges over any shader");
+  app.add_option("--texture", a.texture, "PNG/TGA/JPG texture for texture and phong")
+      ->type_name("PATH");
+  app.add_option("--color", a.color, "Albedo for flat, gouraud and phong (default 0.9,0.6,0.3)")
+      ->type_name("R,G,B");
+  app.add_option("--alpha", a.alpha, "Output alpha in [0, 1] (default 1)")->type_name("A");
+  app.add_option("--filter", a.filter, "Texture filter: nearest or bilinear (default bilinear)")
+      ->type_name("MODE");
+  app.add_option("--wrap", a.wrap, "Texture wrap: repeat, clamp or mirror (default repeat)")
+      ->type_name("MODE");
+}
+
+void define_state_flags(CLI::App& app, RawArgs& a) {
+  app.add_option("--cull", a.cull, "Face culling: back, front or none (default back)")
+      ->type_name("MODE");
+  app.add_option("--front-face", a.front_face, "Front-facing winding: ccw or cw (default ccw)")
+      ->type_name("MODE");
+  app.add_option("--depth", a.depth,
+                 "Depth test: less, lequal, equal, greater, gequal, notequal, always, never or "
+                 "off (default less)")
+      ->type_name("FUNC");
+  app.add_option("--blend", a.blend, "Blending: opaque, alpha or add (default opaque)")
+      ->type_name("MODE");
+  app.add_option("--raster", a.raster, "Rasterizer: edge (tiles) or scanline (default edge)")
+      ->type_name("ALGO");
+}
+
+}  // namespace
+
+void define_render_flags(CLI::App& app, RawArgs& args) {
+  define_output_flags(app, args);
+  define_camera_flags(app, args);
+  define_shading_flags(app, args);
+  define_state_flags(app, args);
+}
+
+}  // namespace softrast::cli

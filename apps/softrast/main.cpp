@@ -1,0 +1,107 @@
+// apps/softrast/main.cpp: the softrast command line. The only place that prints errors and
+// chooses exit codes: 0 success, 1 runtime error (files, memory), 2 usage error (flags).
+//
+//   softrast [render] [MODEL] [-o out.png] [flags]     see `softrast --help`
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <new>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "args.hpp"
+#include "run.hpp"
+#include "setup.hpp"
+
+namespace {
+
+using namespace softrast;
+using namespace softrast::cli;
+
+constexpr int kExitRuntime = 1;
+constexpr int kExitUsage = 2;
+constexpr const char* kVersion = "softrast 0.1.0";
+
+// Every error is one line on stderr with this prefix, whatever produced it.
+void report_error(std::string message) {
+  std::replace_if(
+      message.begin(), message.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+  while (!message.empty() && message.back() == ' ') message.pop_back();
+  std::fprintf(stderr, "softrast: error: %s\n", message.c_str());
+}
+
+// The arguments after the program name, for CLI11 (which wants them reversed), with the
+// `render` subcommand inserted when it is not given: `softrast` alone is `softrast render`.
+std::vector<std::string> command_arguments(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args.front() != "render") args.insert(args.begin(), "render");
+  std::reverse(args.begin(), args.end());
+  return args;
+}
+
+void describe(CLI::App& app, CLI::App& render) {
+  app.require_subcommand(1, 1);
+  render.set_version_flag("--version", kVersion);
+  render.footer(
+      "Without MODEL, renders the built-in demo scene with its camera. Without --eye, a model is "
+      "framed automatically from +z. `softrast` without a subcommand is `softrast render`.\n\n"
+      "Examples:\n"
+      "  softrast render -o demo.png\n"
+      "  softrast render model.obj --size 1920x1080 --shader gouraud --wireframe\n"
+      "  softrast render model.obj --eye 0,1,3 --target 0,0,0 --fov 45 --near 0.1 --far 100\n"
+      "  softrast render scene.obj --frames 10    # one JSON line of timings");
+}
+
+// Parses and checks everything, then loads, renders and writes.
+int render_command(const RawArgs& raw) {
+  Result<JobSpec> spec = interpret(raw);
+  if (!spec) {
+    report_error(spec.status().message());
+    return kExitUsage;
+  }
+  Result<Job> job = prepare(*spec);
+  if (!job) {
+    report_error(job.status().message());
+    return kExitRuntime;
+  }
+  if (Status s = run_job(*job); !s.ok()) {
+    report_error(s.message());
+    return kExitRuntime;
+  }
+  return 0;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{"softrast: a software rasterizer", "softrast"};
+  CLI::App* render = app.add_subcommand("render", "Render a model (or the demo scene) to an image");
+  RawArgs raw;
+  define_render_flags(*render, raw);
+  describe(app, *render);
+  try {
+    std::vector<std::string> args = command_arguments(argc, argv);
+    app.parse(args);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    report_error(std::string(e.what()) + " (see softrast --help)");
+    return kExitUsage;
+  }
+  return render_command(raw);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::bad_alloc&) {
+    report_error("out of memory");
+  } catch (const std::exception& e) {
+    report_error(e.what());
+  } catch (...) {
+    report_error("unexpected failure");
+  }
+  return kExitRuntime;
+}

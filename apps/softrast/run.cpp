@@ -1,0 +1,126 @@
+// apps/softrast/run.cpp: the render loop, frame statistics and the benchmark's JSON line.
+
+#include "run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "softrast/image.hpp"
+#include "softrast/renderer.hpp"
+
+namespace softrast::cli {
+namespace {
+
+// Untimed frames before the timed ones (SCENES.md): caches, page faults, lazy allocations.
+constexpr int kWarmupFrames = 2;
+
+void progress(const Job& job, const std::string& message) {
+  if (!job.quiet) std::fprintf(stderr, "%s\n", message.c_str());
+}
+
+std::string format(const char* fmt, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, fmt, value);
+  return buffer;
+}
+
+std::string size_text(const Job& job) {
+  return std::to_string(job.framebuffer.width()) + "x" + std::to_string(job.framebuffer.height());
+}
+
+// One frame as SCENES.md defines it: clear colour and depth, draw everything. Milliseconds.
+double render_frame(Job& job) {
+  auto start = std::chrono::steady_clock::now();
+  job.framebuffer.clear();
+  render_mesh(job.framebuffer, job.scene.mesh, job.scene.camera, job.options);
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+struct FrameStats {
+  double median_ms, min_ms, max_ms;
+};
+
+// Precondition: at least one time.
+FrameStats stats_of(std::vector<double> ms) {
+  std::sort(ms.begin(), ms.end());
+  size_t n = ms.size();
+  double median = n % 2 == 1 ? ms[n / 2] : 0.5 * (ms[n / 2 - 1] + ms[n / 2]);
+  return {median, ms.front(), ms.back()};
+}
+
+// A JSON string literal: quotes, backslashes and control characters escaped.
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (unsigned char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += char(c);
+    } else if (c < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", c);
+      out += escaped;
+    } else {
+      out += char(c);
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_line(const Job& job, const FrameStats& s) {
+  // A clock too coarse for the frame would give a zero median; the rates stay finite numbers.
+  double seconds = std::max(s.median_ms, 1e-6) / 1000.0;
+  double pixels = double(job.framebuffer.width()) * double(job.framebuffer.height());
+  double triangles = double(job.scene.mesh.triangle_count());
+  return "{\"scene\":" + json_string(job.scene.name) +
+         ",\"shader\":" + json_string(shader_kind_name(job.options.shader)) +
+         ",\"width\":" + std::to_string(job.framebuffer.width()) +
+         ",\"height\":" + std::to_string(job.framebuffer.height()) +
+         ",\"frames\":" + std::to_string(job.frames) +
+         ",\"triangles\":" + std::to_string(job.scene.mesh.triangle_count()) +
+         ",\"median_ms\":" + format("%.3f", s.median_ms) +
+         ",\"min_ms\":" + format("%.3f", s.min_ms) + ",\"max_ms\":" + format("%.3f", s.max_ms) +
+         ",\"mtris_per_s\":" + format("%.3f", triangles / seconds / 1e6) +
+         ",\"mpix_per_s\":" + format("%.3f", pixels / seconds / 1e6) + "}";
+}
+
+Status benchmark(Job& job) {
+  for (int i = 0; i < kWarmupFrames; ++i) render_frame(job);
+  std::vector<double> times;
+  for (int i = 0; i < job.frames; ++i) times.push_back(render_frame(job));
+  FrameStats s = stats_of(times);
+  std::string line = json_line(job, s) + "\n";
+  if (std::fputs(line.c_str(), stdout) == EOF || std::fflush(stdout) != 0) {
+    return Status::error("cannot write the results to the standard output");
+  }
+  progress(job, "rendered " + std::to_string(job.frames) + " frames of " + size_text(job) +
+                    ", median " + format("%.2f", s.median_ms) + " ms");
+  return {};
+}
+
+Status write_image(const Job& job) {
+  Status s = save_image(*job.output, job.framebuffer.to_image());
+  if (s.ok()) progress(job, "wrote " + *job.output);
+  return s;
+}
+
+}  // namespace
+
+Status run_job(Job& job) {
+  progress(job, "loaded " + job.scene.source + ": " +
+                    std::to_string(job.scene.mesh.triangle_count()) + " triangles in " +
+                    format("%.1f", job.scene.load_ms) + " ms");
+  if (job.frames > 0) {
+    if (Status s = benchmark(job); !s.ok()) return s;
+  } else {
+    double ms = render_frame(job);
+    progress(job, "rendered " + size_text(job) + " in " + format("%.1f", ms) + " ms");
+  }
+  if (!job.output) return {};
+  return write_image(job);
+}
+
+}  // namespace softrast::cli

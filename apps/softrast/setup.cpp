@@ -1,0 +1,270 @@
+// apps/softrast/setup.cpp: checking the flags, then the files, then the camera, in that order,
+// so that a mistake costs no loading or rendering time and never leaves an output file.
+
+#include "setup.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <utility>
+
+#include "softrast/image.hpp"
+#include "softrast/texture.hpp"
+#include "values.hpp"
+
+namespace softrast::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kMaxFrames = 1000000;
+
+// Keeps the first error of a sequence of checks, so each check is one line.
+class FirstError {
+ public:
+  template <class T, class U>
+  void take(Result<T> result, U& out) {
+    if (!status_.ok()) return;
+    if (result) {
+      out = std::move(*result);
+    } else {
+      status_ = result.status();
+    }
+  }
+  void fail_if(bool bad, const std::string& message) {
+    if (bad && status_.ok()) status_ = Status::error(message);
+  }
+  const Status& status() const { return status_; }
+
+ private:
+  Status status_;
+};
+
+struct DepthSetting {
+  bool test;
+  DepthFunc func;
+};
+
+constexpr std::array<Named<CullMode>, 3> kCullModes = {
+    {{"back", CullMode::kBack}, {"front", CullMode::kFront}, {"none", CullMode::kNone}}};
+constexpr std::array<Named<FrontFace>, 2> kFrontFaces = {
+    {{"ccw", FrontFace::kCounterClockwise}, {"cw", FrontFace::kClockwise}}};
+constexpr std::array<Named<DepthSetting>, 9> kDepthSettings = {{
+    {"less", {true, DepthFunc::kLess}},
+    {"lequal", {true, DepthFunc::kLessEqual}},
+    {"equal", {true, DepthFunc::kEqual}},
+    {"greater", {true, DepthFunc::kGreater}},
+    {"gequal", {true, DepthFunc::kGreaterEqual}},
+    {"notequal", {true, DepthFunc::kNotEqual}},
+    {"always", {true, DepthFunc::kAlways}},
+    {"never", {true, DepthFunc::kNever}},
+    {"off", {false, DepthFunc::kLess}},
+}};
+constexpr std::array<Named<BlendMode>, 3> kBlendModes = {
+    {{"opaque", BlendMode::kOpaque}, {"alpha", BlendMode::kAlpha}, {"add", BlendMode::kAdditive}}};
+constexpr std::array<Named<RasterAlgorithm>, 2> kRasterAlgorithms = {
+    {{"edge", RasterAlgorithm::kEdgeEquations}, {"scanline", RasterAlgorithm::kScanline}}};
+constexpr std::array<Named<Filter>, 2> kFilters = {
+    {{"nearest", Filter::kNearest}, {"bilinear", Filter::kBilinear}}};
+constexpr std::array<Named<Wrap>, 3> kWraps = {
+    {{"repeat", Wrap::kRepeat}, {"clamp", Wrap::kClampToEdge}, {"mirror", Wrap::kMirroredRepeat}}};
+constexpr std::array<ShaderKind, 7> kShaderKinds = {
+    ShaderKind::kFlat,    ShaderKind::kGouraud, ShaderKind::kTexture,  ShaderKind::kPhong,
+    ShaderKind::kNormals, ShaderKind::kDepth,   ShaderKind::kWireframe};
+
+Result<ShaderKind> shader_named(const std::string& name) {
+  if (std::optional<ShaderKind> kind = parse_shader_kind(name)) return *kind;
+  std::vector<std::string_view> names;
+  for (ShaderKind kind : kShaderKinds) names.push_back(shader_kind_name(kind));
+  return Status::error("--shader: unknown shader '" + name + "' (expected " + name_list(names) +
+                       ")");
+}
+
+bool in_unit_range(float x) {
+  return x >= 0.0f && x <= 1.0f;
+}
+
+std::string lowercase_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+void interpret_state(const RawArgs& a, RenderState& state, FirstError& e) {
+  e.take(lookup<CullMode>("--cull", kCullModes, a.cull), state.cull);
+  e.take(lookup<FrontFace>("--front-face", kFrontFaces, a.front_face), state.front_face);
+  DepthSetting depth{true, DepthFunc::kLess};
+  e.take(lookup<DepthSetting>("--depth", kDepthSettings, a.depth), depth);
+  state.depth_test = depth.test;
+  state.depth_func = depth.func;
+  e.take(lookup<BlendMode>("--blend", kBlendModes, a.blend), state.blend);
+  e.take(lookup<RasterAlgorithm>("--raster", kRasterAlgorithms, a.raster), state.raster);
+}
+
+void interpret_shading(const RawArgs& a, RenderOptions& options, FirstError& e) {
+  e.take(shader_named(a.shader), options.shader);
+  options.wireframe_overlay = a.wireframe;
+  if (a.color) {
+    e.take(parse_vec3("--color", *a.color), options.color);
+    glm::vec3 c = options.color;
+    e.fail_if(!in_unit_range(c.r) || !in_unit_range(c.g) || !in_unit_range(c.b),
+              "--color: every channel must be in [0, 1], got '" + *a.color + "'");
+  }
+  e.fail_if(!in_unit_range(a.alpha), "--alpha: must be in [0, 1]");
+  options.alpha = a.alpha;
+  e.take(lookup<Filter>("--filter", kFilters, a.filter), options.sampler.filter);
+  e.take(lookup<Wrap>("--wrap", kWraps, a.wrap), options.sampler.wrap_u);
+  options.sampler.wrap_v = options.sampler.wrap_u;
+}
+
+// What can be said about the camera before the scene is known; the complete check is
+// Camera::validate() once the scene's defaults are filled in.
+void check_camera_flags(const CameraFlags& c, FirstError& e) {
+  if (c.fov) e.fail_if(!(*c.fov > 0.0f && *c.fov < 180.0f), "--fov: must be in (0, 180) degrees");
+  if (c.near_plane) e.fail_if(!std::isfinite(*c.near_plane), "--near: must be a finite number");
+  if (c.far_plane) e.fail_if(!std::isfinite(*c.far_plane), "--far: must be a finite number");
+  if (c.near_plane && !c.ortho) {
+    e.fail_if(!(*c.near_plane > 0.0f), "--near: must be > 0 with a perspective projection");
+  }
+  if (c.near_plane && c.far_plane) {
+    e.fail_if(!(*c.near_plane < *c.far_plane), "--near must be less than --far");
+  }
+  if (c.eye && c.target) e.fail_if(*c.eye == *c.target, "--eye and --target must differ");
+  if (c.ortho) {
+    glm::vec4 box = *c.ortho;
+    e.fail_if(box.x == box.y || box.z == box.w, "--ortho: the box is empty");
+  }
+}
+
+void interpret_camera(const RawArgs& a, CameraFlags& c, FirstError& e) {
+  if (a.eye) e.take(parse_vec3("--eye", *a.eye), c.eye);
+  if (a.target) e.take(parse_vec3("--target", *a.target), c.target);
+  if (a.up) e.take(parse_vec3("--up", *a.up), c.up);
+  if (a.ortho) e.take(parse_vec4("--ortho", *a.ortho), c.ortho);
+  c.fov = a.fov;
+  c.near_plane = a.near_plane;
+  c.far_plane = a.far_plane;
+  check_camera_flags(c, e);
+}
+
+void interpret_output(const RawArgs& a, JobSpec& spec, FirstError& e) {
+  if (a.size) {
+    glm::ivec2 size(0);
+    e.take(parse_size("--size", *a.size), size);
+    spec.width = size.x;
+    spec.height = size.y;
+  }
+  if (a.frames) {
+    e.fail_if(*a.frames < 1 || *a.frames > kMaxFrames,
+              "--frames: must be in 1.." + std::to_string(kMaxFrames));
+    spec.frames = *a.frames;
+  }
+  spec.output = a.output;
+  if (!spec.output && spec.frames == 0) spec.output = "softrast.png";
+  if (spec.output) {
+    std::string ext = lowercase_extension(*spec.output);
+    e.fail_if(ext != ".png" && ext != ".tga",
+              *spec.output + ": unknown image format (the output must end in .png or .tga)");
+  }
+}
+
+// The folder must exist and be writable now, not after a long render.
+Status check_output_path(const std::string& path) {
+  fs::path dir = fs::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
+    return Status::error(path + ": '" + dir.string() + "' is not an existing folder");
+  }
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) {
+    return Status::error(path + ": cannot write in folder '" + dir.string() +
+                         "': " + std::strerror(errno));
+  }
+  if (fs::is_directory(path, ec)) return Status::error(path + ": is a folder");
+  return {};
+}
+
+Result<std::shared_ptr<const Texture>> load_texture(const std::string& path) {
+  Result<Image> image = load_image(path);
+  if (!image) return image.status();
+  return std::shared_ptr<const Texture>(std::make_shared<Texture>(Texture::from_image(*image)));
+}
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+// A model file framed automatically, or the demo scene with its own camera; the flags override
+// either.
+Result<Scene> load_scene(const JobSpec& spec) {
+  auto start = std::chrono::steady_clock::now();
+  Scene scene;
+  if (!spec.model) {
+    DemoScene demo = make_demo_scene();
+    scene.mesh = std::move(demo.mesh);
+    scene.camera = demo.camera;
+    apply_flags(scene.camera, spec.camera);
+  } else {
+    Result<Mesh> mesh = load_obj(*spec.model);
+    if (!mesh) return mesh.status();
+    scene.mesh = std::move(*mesh);
+    float aspect = float(spec.width) / float(spec.height);
+    scene.camera = frame_model(bounds_of(scene.mesh), spec.camera, aspect);
+  }
+  scene.load_ms = milliseconds_since(start);
+  scene.name = spec.model ? fs::path(*spec.model).stem().string() : "demo";
+  scene.source = spec.model ? *spec.model : "demo scene";
+  if (Status s = scene.camera.validate(); !s.ok()) return s;
+  return scene;
+}
+
+}  // namespace
+
+Result<JobSpec> interpret(const RawArgs& args) {
+  JobSpec spec;
+  FirstError e;
+  interpret_output(args, spec, e);
+  interpret_camera(args, spec.camera, e);
+  interpret_shading(args, spec.options, e);
+  interpret_state(args, spec.options.state, e);
+  if (!e.status().ok()) return e.status();
+  spec.model = args.model;
+  spec.texture = args.texture;
+  spec.quiet = args.quiet;
+  return spec;
+}
+
+Result<Job> prepare(const JobSpec& spec) {
+  if (spec.output) {
+    if (Status s = check_output_path(*spec.output); !s.ok()) return s;
+  }
+  RenderOptions options = spec.options;
+  if (spec.texture) {
+    Result<std::shared_ptr<const Texture>> texture = load_texture(*spec.texture);
+    if (!texture) return texture.status();
+    options.texture = std::move(*texture);
+  }
+  Result<Scene> scene = load_scene(spec);
+  if (!scene) return scene.status();
+  // Allocated last: up to 2 GiB for the largest size, not worth spending on a bad model.
+  Result<Framebuffer> framebuffer = Framebuffer::create(spec.width, spec.height);
+  if (!framebuffer) return framebuffer.status();
+  Job job(std::move(*scene), std::move(*framebuffer));
+  job.options = std::move(options);
+  job.output = spec.output;
+  job.frames = spec.frames;
+  job.quiet = spec.quiet;
+  return job;
+}
+
+}  // namespace softrast::cli

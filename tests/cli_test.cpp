@@ -1,0 +1,392 @@
+// tests/cli_test.cpp: the softrast command line, run as a separate process in a fresh folder.
+// Checks the images it writes, --help, --version, the --frames JSON line, and that every bad
+// input fails with exactly one "softrast: error: " line and leaves no file behind (not even a
+// temporary one).
+#ifdef SOFTRAST_CLI_PATH
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <ostream>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "softrast/framebuffer.hpp"
+#include "softrast/image.hpp"
+
+namespace softrast {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Files every test folder starts with.
+const std::set<std::string> kFixtures = {"quad.obj", "empty.obj", "bad_index.obj", "garbage.png",
+                                         "texture.png"};
+
+// A 2 x 2 square facing +z (counter-clockwise seen from +z), with uvs.
+constexpr const char* kQuadObj =
+    "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+    "f 1/1 2/2 3/3 4/4\n";
+constexpr const char* kBadIndexObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Single quotes for sh; a single quote inside becomes '\''.
+std::string quote(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+size_t count_lines(const std::string& text) {
+  return size_t(std::count(text.begin(), text.end(), '\n'));
+}
+
+// A 4 x 4 image with four differently coloured quadrants.
+Image quadrant_texture() {
+  Image image(4, 4);
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 4; ++x) {
+      uint8_t* p = image.pixel(x, y);
+      p[0] = x < 2 ? 255 : 0;
+      p[1] = y < 2 ? 255 : 0;
+      p[2] = 128;
+      p[3] = 255;
+    }
+  }
+  return image;
+}
+
+// Each test gets a fresh folder: work/ is the program's current directory (and must hold only
+// the fixtures and the expected outputs afterwards), logs/ receives stdout and stderr.
+class CliTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "softrast_cli_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
+    root_ = pattern;
+    fs::create_directories(work_dir());
+    fs::create_directories(root_ / "logs");
+    write("quad.obj", kQuadObj);
+    write("empty.obj", "");
+    write("bad_index.obj", kBadIndexObj);
+    write("garbage.png", "this is not an image\n");
+    ASSERT_TRUE(save_image(path("texture.png"), quadrant_texture()).ok());
+  }
+  void TearDown() override { fs::remove_all(root_); }
+
+  fs::path work_dir() const { return root_ / "work"; }
+  std::string path(const std::string& name) const { return (work_dir() / name).string(); }
+  void write(const std::string& name, const std::string& bytes) const {
+    std::ofstream(work_dir() / name, std::ios::binary) << bytes;
+  }
+  std::set<std::string> files() const {
+    std::set<std::string> names;
+    for (const auto& entry : fs::directory_iterator(work_dir())) {
+      names.insert(entry.path().filename().string());
+    }
+    return names;
+  }
+  std::set<std::string> fixtures_and(const std::set<std::string>& outputs) const {
+    std::set<std::string> names = kFixtures;
+    names.insert(outputs.begin(), outputs.end());
+    return names;
+  }
+
+  // Runs `softrast ARGS` (ARGS as typed in a shell) in the work folder.
+  CliRun run(const std::string& args) const {
+    fs::path out = root_ / "logs" / "stdout", err = root_ / "logs" / "stderr";
+    std::string command = "cd " + quote(work_dir().string()) + " && " + quote(SOFTRAST_CLI_PATH) +
+                          " " + args + " >" + quote(out.string()) + " 2>" + quote(err.string()) +
+                          " </dev/null";
+    int status = std::system(command.c_str());
+    CliRun result;
+    if (status != -1 && WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
+    result.out = read_file(out);
+    result.err = read_file(err);
+    return result;
+  }
+
+  // The image `name` in the work folder, checked to decode at the given size.
+  Image load(const std::string& name, int width, int height) const {
+    Result<Image> image = load_image(path(name));
+    EXPECT_TRUE(image.ok()) << image.status().message();
+    if (!image) return {};
+    EXPECT_EQ(image->width, width);
+    EXPECT_EQ(image->height, height);
+    return *image;
+  }
+
+  fs::path root_;
+};
+
+bool all_one_colour(const Image& image) {
+  for (size_t i = 4; i < image.rgba.size(); i += 4) {
+    if (!std::equal(&image.rgba[i], &image.rgba[i + 4], &image.rgba[0])) return false;
+  }
+  return true;
+}
+
+std::vector<int> pixel(const Image& image, int x, int y) {
+  const uint8_t* p = image.pixel(x, y);
+  return {p[0], p[1], p[2], p[3]};
+}
+
+TEST_F(CliTest, NoArgumentsRendersTheDemoSceneToSoftrastPng) {
+  CliRun r = run("");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(files(), fixtures_and({"softrast.png"}));
+  Image image = load("softrast.png", 800, 600);
+  EXPECT_FALSE(all_one_colour(image));
+  EXPECT_NE(r.err.find("wrote softrast.png"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out, "");
+}
+
+TEST_F(CliTest, RenderWithoutModelRendersTheDemoScene) {
+  CliRun r = run("render --size 64x48 --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_FALSE(all_one_colour(load("softrast.png", 64, 48)));
+}
+
+TEST_F(CliTest, SizeAndOutputChooseTheImage) {
+  CliRun png = run("render --size 160x90 -o small.png");
+  ASSERT_EQ(png.exit_code, 0) << png.err;
+  CliRun tga = run("--size 33x17 --out small.TGA");
+  ASSERT_EQ(tga.exit_code, 0) << tga.err;
+  EXPECT_EQ(files(), fixtures_and({"small.png", "small.TGA"}));
+  EXPECT_FALSE(all_one_colour(load("small.png", 160, 90)));
+  load("small.TGA", 33, 17);
+}
+
+TEST_F(CliTest, ModelIsFramedAutomatically) {
+  CliRun r = run("quad.obj --size 64x48 --shader flat -o quad.png");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("quad.obj: 2 triangles"), std::string::npos) << r.err;
+  Image image = load("quad.png", 64, 48);
+  // The albedo (0.9, 0.6, 0.3) in the middle, the clear colour (0.1, 0.1, 0.1) in the corners.
+  int clear = to_unorm8(0.1f);
+  EXPECT_EQ(pixel(image, 32, 24),
+            (std::vector<int>{to_unorm8(0.9f), to_unorm8(0.6f), to_unorm8(0.3f), 255}));
+  EXPECT_EQ(pixel(image, 0, 0), (std::vector<int>{clear, clear, clear, 255}));
+  EXPECT_EQ(pixel(image, 63, 47), (std::vector<int>{clear, clear, clear, 255}));
+}
+
+TEST_F(CliTest, ExplicitCameraOverridesTheFraming) {
+  // From behind, the square is back-facing and culled: only the clear colour remains.
+  CliRun r = run("quad.obj --size 32x32 --eye 0,0,-5 --target 0,0,0 --up 0,1,0 -o back.png");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(all_one_colour(load("back.png", 32, 32)));
+  CliRun none = run("quad.obj --size 32x32 --eye 0,0,-5 --cull none -o both.png");
+  ASSERT_EQ(none.exit_code, 0) << none.err;
+  EXPECT_FALSE(all_one_colour(load("both.png", 32, 32)));
+}
+
+TEST_F(CliTest, EveryRenderFlagIsAccepted) {
+  const char* kRuns[] = {
+      "quad.obj --shader gouraud --cull none --front-face cw --depth lequal --blend alpha "
+      "--alpha 0.5 --raster scanline --filter nearest --wrap clamp --wireframe "
+      "--color 0.2,0.4,0.6 --fov 60 --near 0.5 --far 50 --eye 0,0,5 --target 0,0,0 --up 0,1,0",
+      "quad.obj --ortho -2,2,-1.5,1.5 --near -1 --far 10 --shader normals --depth off",
+      "quad.obj --shader texture --texture texture.png --wrap mirror --blend add",
+      "quad.obj --shader phong --texture texture.png --depth always --cull front",
+      "--shader depth --depth gequal",
+      "--shader wireframe --depth notequal",
+      "--shader flat --depth greater --raster edge --filter bilinear --wrap repeat",
+      "--shader phong --depth equal --cull back --front-face ccw --blend opaque",
+      "--depth never",
+  };
+  for (const char* args : kRuns) {
+    CliRun r = run(std::string(args) + " --size 40x30 -o flags.png");
+    EXPECT_EQ(r.exit_code, 0) << args << "\n" << r.err;
+    load("flags.png", 40, 30);
+  }
+}
+
+TEST_F(CliTest, TextureShaderShowsTheTexture) {
+  CliRun r = run("quad.obj --size 64x64 --shader texture --texture texture.png -o t.png");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  Image image = load("t.png", 64, 64);
+  EXPECT_FALSE(all_one_colour(image));
+  // Texture row 0 (top) has green; v = 1 is the top of the square.
+  EXPECT_EQ(pixel(image, 26, 26)[1], 255);
+}
+
+TEST_F(CliTest, HelpMentionsEveryFlag) {
+  for (const char* args : {"--help", "render --help", "-h"}) {
+    CliRun r = run(args);
+    EXPECT_EQ(r.exit_code, 0) << args;
+    EXPECT_EQ(r.err, "") << args;
+    for (const char* flag :
+         {"--size",  "--eye",    "--target",    "--up",      "--fov",    "--ortho", "--near",
+          "--far",   "--shader", "--wireframe", "--texture", "--color",  "--cull",  "--front-face",
+          "--depth", "--blend",  "--alpha",     "--raster",  "--filter", "--wrap",  "--frames",
+          "--quiet", "--help",   "--version",   "-o",        "MODEL",    "flat",    "gouraud",
+          "phong",   "normals",  "scanline",    "notequal",  "mirror"}) {
+      EXPECT_NE(r.out.find(flag), std::string::npos) << args << " does not mention " << flag;
+    }
+  }
+  EXPECT_EQ(files(), kFixtures);
+}
+
+TEST_F(CliTest, VersionPrintsTheProgramName) {
+  CliRun r = run("--version");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.out.rfind("softrast ", 0), 0u) << r.out;
+  EXPECT_EQ(files(), kFixtures);
+}
+
+// One line of JSON with every field; `triangles` < 0: any count.
+void expect_json_line(const std::string& out, const std::string& scene, int triangles) {
+  ASSERT_EQ(count_lines(out), 1u) << out;
+  ASSERT_EQ(out.front(), '{') << out;
+  ASSERT_EQ(out.substr(out.size() - 2), "}\n") << out;
+  for (const std::string& field :
+       {"\"scene\":\"" + scene + "\"", std::string("\"shader\":\"phong\""),
+        std::string("\"width\":64"), std::string("\"height\":48"), std::string("\"frames\":3"),
+        "\"triangles\":" + (triangles < 0 ? "" : std::to_string(triangles) + ","),
+        std::string("\"median_ms\":"), std::string("\"min_ms\":"), std::string("\"max_ms\":"),
+        std::string("\"mtris_per_s\":"), std::string("\"mpix_per_s\":")}) {
+    EXPECT_NE(out.find(field), std::string::npos) << field << " missing in " << out;
+  }
+}
+
+TEST_F(CliTest, FramesPrintsOneJsonLineAndWritesOnlyWithOutput) {
+  CliRun r = run("--frames 3 --size 64x48");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  expect_json_line(r.out, "demo", -1);
+  EXPECT_EQ(files(), kFixtures);  // no -o: no image
+
+  CliRun model = run("quad.obj --frames 3 --size 64x48 -o bench.png -q");
+  ASSERT_EQ(model.exit_code, 0) << model.err;
+  expect_json_line(model.out, "quad", 2);
+  EXPECT_EQ(model.err, "");
+  EXPECT_EQ(files(), fixtures_and({"bench.png"}));
+  load("bench.png", 64, 48);
+}
+
+TEST_F(CliTest, FailureLeavesAnExistingOutputAlone) {
+  write("keep.png", "old contents");
+  CliRun r = run("missing.obj -o keep.png");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(read_file(work_dir() / "keep.png"), "old contents");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input: one error line, non-zero exit, no file written.
+
+struct BadInput {
+  const char* name;
+  const char* args;
+};
+// For test listings: the command line rather than the struct's bytes.
+void PrintTo(const BadInput& input, std::ostream* os) {
+  *os << "softrast " << input.args;
+}
+
+const BadInput kBadInputs[] = {
+    {"MissingModel", "missing.obj -o out.png"},
+    {"EmptyObj", "empty.obj -o out.png"},
+    {"FaceIndexOutOfRange", "bad_index.obj -o out.png"},
+    {"GarbageTexture", "quad.obj --texture garbage.png -o out.png"},
+    {"MissingTexture", "quad.obj --texture missing.png -o out.png"},
+    {"TextureIsAnObj", "--texture quad.obj -o out.png"},
+    {"ZeroSize", "--size 0x100 -o out.png"},
+    {"ZeroHeight", "--size 100x0 -o out.png"},
+    {"NegativeSize", "--size=-5x10 -o out.png"},
+    {"NegativeSizeSeparate", "--size -5x10 -o out.png"},
+    {"HugeSize", "--size 100000x100000 -o out.png"},
+    {"JustTooLarge", "--size 16385x16 -o out.png"},
+    {"SizeOverflowsInt", "--size 99999999999999999999x10 -o out.png"},
+    {"SizeMissingHeight", "--size 12x -o out.png"},
+    {"SizeNoSeparator", "--size 1200 -o out.png"},
+    {"SizeWithSpaces", "--size '12 x 12' -o out.png"},
+    {"SizeFloat", "--size 12.5x10 -o out.png"},
+    {"SizeWithoutValue", "--size"},
+    {"NearEqualsFar", "--near 5 --far 5 -o out.png"},
+    {"NearBeyondFar", "--near 10 --far 1 -o out.png"},
+    {"NearZeroPerspective", "--near 0 -o out.png"},
+    {"NearNegativePerspective", "--near=-1 -o out.png"},
+    {"NearBeyondDemoFar", "--near 100000 -o out.png"},
+    {"FovZero", "--fov 0 -o out.png"},
+    {"FovNegative", "--fov=-10 -o out.png"},
+    {"Fov180", "--fov 180 -o out.png"},
+    {"FovHuge", "--fov 400 -o out.png"},
+    {"FovNotANumber", "--fov wide -o out.png"},
+    {"EyeTwoNumbers", "--eye 1,2 -o out.png"},
+    {"EyeFourNumbers", "--eye 1,2,3,4 -o out.png"},
+    {"EyeNotNumbers", "--eye a,b,c -o out.png"},
+    {"EyeTrailingComma", "--eye 1,2,3, -o out.png"},
+    {"EyeNaN", "--eye nan,0,0 -o out.png"},
+    {"TargetTwoNumbers", "--target 1,2 -o out.png"},
+    {"UpTwoNumbers", "--up 0,1 -o out.png"},
+    {"UpZero", "--up 0,0,0 -o out.png"},
+    {"UpAlongView", "quad.obj --up 0,0,1 -o out.png"},
+    {"ColorTwoNumbers", "--color 1,2 -o out.png"},
+    {"ColorOutOfRange", "--color 2,0,0 -o out.png"},
+    {"OrthoThreeNumbers", "--ortho 1,2,3 -o out.png"},
+    {"OrthoEmptyBox", "--ortho 1,1,0,1 -o out.png"},
+    {"AlphaOutOfRange", "--alpha 1.5 -o out.png"},
+    {"EyeEqualsTarget", "--eye 1,1,1 --target 1,1,1 -o out.png"},
+    {"ModelEyeEqualsTarget", "quad.obj --eye 0,0,0 --target 0,0,0 -o out.png"},
+    {"UnknownFlag", "--bogus -o out.png"},
+    {"UnknownShortFlag", "-z -o out.png"},
+    {"TwoModels", "render quad.obj quad.obj -o out.png"},
+    {"UnknownShader", "--shader toon -o out.png"},
+    {"UnknownCull", "--cull sideways -o out.png"},
+    {"UnknownFrontFace", "--front-face up -o out.png"},
+    {"UnknownDepth", "--depth sometimes -o out.png"},
+    {"UnknownBlend", "--blend multiply -o out.png"},
+    {"UnknownRaster", "--raster raytrace -o out.png"},
+    {"UnknownFilter", "--filter trilinear -o out.png"},
+    {"UnknownWrap", "--wrap border -o out.png"},
+    {"FramesZero", "--frames 0 -o out.png"},
+    {"FramesNegative", "--frames=-2 -o out.png"},
+    {"FramesNotANumber", "--frames many -o out.png"},
+    {"OutputFolderMissing", "-o /nonexistent/dir/out.png"},
+    {"OutputBesideAFile", "-o quad.obj/out.png"},
+    {"OutputExtensionBmp", "-o out.bmp"},
+    {"OutputNoExtension", "-o out"},
+    {"OutputIsAFolder", "-o ."},
+    {"OutputExtensionWithModel", "quad.obj -o out.jpg"},
+    {"FramesWithBadOutput", "--frames 2 -o /nonexistent/dir/out.png"},
+};
+
+class CliBadInputTest : public CliTest, public testing::WithParamInterface<BadInput> {};
+
+TEST_P(CliBadInputTest, FailsWithOneErrorLineAndNoFile) {
+  CliRun r = run(GetParam().args);
+  EXPECT_NE(r.exit_code, 0) << GetParam().args;
+  EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+  EXPECT_EQ(r.err.rfind("softrast: error: ", 0), 0u) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(files(), kFixtures);  // no output, no temporary file
+}
+
+INSTANTIATE_TEST_SUITE_P(Cli, CliBadInputTest, testing::ValuesIn(kBadInputs),
+                         [](const testing::TestParamInfo<BadInput>& info) {
+                           return std::string(info.param.name);
+                         });
+
+}  // namespace
+}  // namespace softrast
+
+#endif  // SOFTRAST_CLI_PATH
