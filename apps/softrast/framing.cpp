@@ -58,7 +58,9 @@ Bounds bounds_of(const Mesh& mesh) {
     lo = glm::min(lo, p);
     hi = glm::max(hi, p);
   }
-  Bounds bounds{(lo + hi) * 0.5f, glm::length(hi - lo) * 0.5f};
+  glm::vec3 size = hi - lo;
+  Bounds bounds{(lo + hi) * 0.5f, glm::length(size) * 0.5f};
+  bounds.flat_in_y = size.y < 0.1f * std::min(size.x, size.z);
   if (!(bounds.radius > 0.0f && std::isfinite(bounds.radius))) bounds.radius = 1.0f;
   return bounds;
 }
@@ -68,7 +70,11 @@ Camera frame_model(const Bounds& bounds, const CameraFlags& flags, float aspect)
   apply_flags(camera, flags);
   camera.target = flags.target.value_or(bounds.center);
   float distance = fit_distance(bounds.radius, camera, aspect);
-  camera.eye = flags.eye.value_or(camera.target + glm::vec3(0.0f, 0.0f, distance));
+  // Look along -z; a model flat in y (a floor, a terrain) is seen from 45 degrees above instead
+  // of edge-on.
+  glm::vec3 direction =
+      bounds.flat_in_y ? glm::normalize(glm::vec3(0.0f, 1.0f, 1.0f)) : glm::vec3(0.0f, 0.0f, 1.0f);
+  camera.eye = flags.eye.value_or(camera.target + direction * distance);
   set_depth_range(camera, bounds, flags);
   return camera;
 }

@@ -24,6 +24,7 @@ struct CameraFlags {
 struct Bounds {
   glm::vec3 center{0.0f};
   float radius = 1.0f;
+  bool flat_in_y = false;  // height under a tenth of the width and depth: a ground plane
 };
 Bounds bounds_of(const Mesh& mesh);
 
