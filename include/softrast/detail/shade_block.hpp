@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cstdint>
 
+#include <glm/common.hpp>  // glm::clamp
 #include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
 #include "softrast/detail/interpolants.hpp"
