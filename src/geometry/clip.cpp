@@ -1,6 +1,7 @@
 // geometry/clip.cpp: Sutherland-Hodgman against the seven planes of the clip volume.
 #include "geometry/clip.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -29,13 +30,44 @@ double plane_distance(int plane, const float* p, const ClipVolume& vol) {
   }
 }
 
-// The point where the segment from `in` (inside) to `out` (outside) crosses the plane.
-void intersect(const ClipVertex& in, const ClipVertex& out, double d_in, double d_out,
-               int num_floats, ClipVertex& result) {
-  double t = d_in / (d_in - d_out);
+// The point where the segment from `in` (inside) to `out` (outside) crosses plane p.
+// Interpolating from the nearer endpoint keeps the error proportional to the part of the segment
+// that is interpolated over; with endpoints at 1e30 and the crossing near the origin, starting
+// from the far one would leave an error of 1e14. The coordinate the plane constrains is then set
+// exactly onto the plane, so the next passes see the vertex inside it and never with w <= 0.
+void intersect(int plane, const ClipVertex& in, const ClipVertex& out, double d_in, double d_out,
+               int num_floats, const ClipVolume& vol, ClipVertex& result) {
+  double t = d_in / (d_in - d_out);  // from `in`, in [0, 1]
+  const ClipVertex& from = t <= 0.5 ? in : out;
+  const ClipVertex& to = t <= 0.5 ? out : in;
+  double s = t <= 0.5 ? t : d_out / (d_out - d_in);
   for (int i = 0; i < num_floats; ++i) {
-    double a = in.v[i], b = out.v[i];
-    result.v[i] = float(a + t * (b - a));
+    double a = from.v[i], b = to.v[i];
+    result.v[i] = float(a + s * (b - a));
+  }
+  float* p = result.v;
+  switch (plane) {
+    case 0:
+      p[3] = kMinClipW;
+      break;
+    case 1:
+      p[2] = -p[3];
+      break;
+    case 2:
+      p[2] = p[3];
+      break;
+    case 3:
+      p[0] = float(-vol.guard_x * p[3]);
+      break;
+    case 4:
+      p[0] = float(vol.guard_x * p[3]);
+      break;
+    case 5:
+      p[1] = float(-vol.guard_y * p[3]);
+      break;
+    default:
+      p[1] = float(vol.guard_y * p[3]);
+      break;
   }
 }
 
@@ -50,8 +82,8 @@ int clip_polygon_against(int plane, const ClipVertex* src, int n, int num_floats
     double d_next = plane_distance(plane, next.v, vol);
     bool cur_in = d_cur >= 0.0, next_in = d_next >= 0.0;
     if (cur_in) dst[m++] = cur;
-    if (cur_in && !next_in) intersect(cur, next, d_cur, d_next, num_floats, dst[m++]);
-    if (!cur_in && next_in) intersect(next, cur, d_next, d_cur, num_floats, dst[m++]);
+    if (cur_in && !next_in) intersect(plane, cur, next, d_cur, d_next, num_floats, vol, dst[m++]);
+    if (!cur_in && next_in) intersect(plane, next, cur, d_next, d_cur, num_floats, vol, dst[m++]);
   }
   return m;
 }
@@ -98,10 +130,10 @@ bool clip_line(const ClipVertex& a, const ClipVertex& b, int num_floats, const C
     if (a_in && b_in) continue;
     ClipVertex cut;
     if (a_in) {
-      intersect(out_a, out_b, da, db, num_floats, cut);
+      intersect(p, out_a, out_b, da, db, num_floats, volume, cut);
       out_b = cut;
     } else {
-      intersect(out_b, out_a, db, da, num_floats, cut);
+      intersect(p, out_b, out_a, db, da, num_floats, volume, cut);
       out_a = cut;
     }
   }

@@ -25,8 +25,17 @@ struct ClipVolume {
 // projections; this plane protects arbitrary user matrices from w <= 0.
 inline constexpr float kMinClipW = 1.0e-6f;
 inline constexpr int kNumClipPlanes = 7;
-// Sutherland-Hodgman adds at most one vertex per plane.
-inline constexpr int kMaxClippedVertices = 3 + kNumClipPlanes;
+// Sutherland-Hodgman adds at most one vertex per plane to a convex polygon, but rounding can make
+// the polygon slightly non-convex near plane corners, and then a pass can add more: a pass over n
+// vertices writes at most floor(3n / 2) (every inside vertex plus one per in/out crossing). Over
+// seven passes from 3 vertices: 4, 6, 9, 13, 19, 28, 42.
+constexpr int max_clipped_vertices() {
+  int n = 3;
+  for (int p = 0; p < kNumClipPlanes; ++p) n = n * 3 / 2;
+  return n;
+}
+inline constexpr int kMaxClippedVertices = max_clipped_vertices();
+static_assert(kMaxClippedVertices == 42);
 
 // Bit p is set when the position is outside plane p. NaN or Inf positions are outside all planes.
 uint32_t clip_outcode(const float* position, const ClipVolume& volume);
@@ -34,8 +43,8 @@ bool is_finite_position(const float* position);
 
 // Clips a triangle to the volume. Writes the polygon (a convex fan, in the input winding) to
 // `out` and returns its vertex count: 0 (all clipped) or 3..kMaxClippedVertices.
-// Every new vertex is interpolated from the inside endpoint towards the outside one, so an edge
-// shared by two triangles yields bit-identical new vertices whichever way each triangle walks it.
+// A new vertex depends only on the (inside, outside) pair of endpoints, never on the direction a
+// triangle walks the edge, so two triangles sharing an edge get bit-identical new vertices.
 int clip_triangle(const ClipVertex* const in[3], int num_floats, const ClipVolume& volume,
                   ClipVertex out[kMaxClippedVertices]);
 

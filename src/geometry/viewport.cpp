@@ -12,6 +12,7 @@ namespace {
 int32_t snap(double window_coord) {
   double fx = std::nearbyint(window_coord * kSubpixelOne);
   double limit = double(kMaxCoordFx8 - 1);
+  if (std::isnan(fx)) return 0;  // unreachable after clipping; never convert NaN to int
   return int32_t(std::clamp(fx, -limit, limit));
 }
 

@@ -163,7 +163,9 @@ void DrawContext::point(uint32_t i) {
   if (clip_outcode(p, volume_) != 0) return;  // includes NaN and Inf
   Interpolants interp;
   int x, y;
-  if (!setup_point(viewport_.to_window(p), vertices_.num_varyings, scissor_, x, y, interp)) return;
+  WindowVertex w = viewport_.to_window(p);
+  w.z = std::clamp(w.z + state_.depth_bias, 0.0f, 1.0f);
+  if (!setup_point(w, vertices_.num_varyings, scissor_, x, y, interp)) return;
   int bx = x & ~(kBlockSize - 1), by = y & ~(kBlockSize - 1);
   sink(interp)(bx, by, 1u << (4 * (y - by) + (x - bx)));
 }
