@@ -72,9 +72,9 @@ class BandWriter {
   int hi_[4] = {0, 0, 0, 0};
 };
 
-// Walks rows [row0, row1) between two edges; `extra` (may be null) also bounds the first row.
-void walk_trapezoid(const EdgeFunction& e0, const EdgeFunction& e1, const EdgeFunction* extra,
-                    int extra_row, int row0, int row1, const PixelRect& area, BandWriter& out) {
+// Walks rows [row0, row1) between two edges.
+void walk_trapezoid(const EdgeFunction& e0, const EdgeFunction& e1, int row0, int row1,
+                    const PixelRect& area, BandWriter& out) {
   if (row0 >= row1) return;
   WalkedEdge left{&e0, 0}, right{&e1, 0};
   left.start(row0);
@@ -83,11 +83,6 @@ void walk_trapezoid(const EdgeFunction& e0, const EdgeFunction& e1, const EdgeFu
     int64_t lo = area.x0, hi = area.x1;
     left.clip_span(lo, hi);
     right.clip_span(lo, hi);
-    if (extra && row == extra_row) {
-      WalkedEdge third{extra, 0};
-      third.start(row);
-      third.clip_span(lo, hi);
-    }
     if (lo < hi) out.add_span(row, lo, hi);
   }
 }
@@ -115,22 +110,21 @@ void rasterize_triangle_scanline(const TriangleSetup& tri, const PixelRect& regi
   };
 
   // Rows with a sample in [y_top, y_mid) belong to the upper trapezoid, [y_mid, y_bottom) to the
-  // lower one. Samples exactly at y_bottom can only touch the bottom vertex or a bottom edge,
-  // which the fill rule excludes; a sample row exactly through the middle vertex is bounded by
-  // the third edge too (it decides on the vertex itself, or on the whole row when that edge is
-  // the horizontal top edge).
+  // lower one. Within a trapezoid the third edge is strictly positive, so two edges decide.
+  // Samples exactly at y_bottom can only touch the bottom vertex or a bottom edge, which the fill
+  // rule excludes. On a sample row through the middle vertex the third edge adds nothing either:
+  // the middle vertex joins two edges of the same side (both left, both included on the line,
+  // or both right, both excluded), and a horizontal third edge there is a top edge (included).
   int row_top = std::max(first_row_at_or_below(tri.vy[top]), area.y0);
   int row_mid = std::clamp(first_row_at_or_below(tri.vy[mid]), row_top, area.y1);
   int row_bottom = std::clamp(first_row_at_or_below(tri.vy[bottom]), row_mid, area.y1);
-  bool mid_on_row = (tri.vy[mid] - kSubpixelHalf) % kSubpixelOne == 0;
 
   BandWriter out(sink);
   const EdgeFunction *p, *q;
   others(top, p, q);
-  walk_trapezoid(*p, *q, nullptr, 0, row_top, row_mid, area, out);
+  walk_trapezoid(*p, *q, row_top, row_mid, area, out);
   others(bottom, p, q);
-  walk_trapezoid(*p, *q, mid_on_row ? &tri.edge[opposite(bottom)] : nullptr,
-                 first_row_at_or_below(tri.vy[mid]), row_mid, row_bottom, area, out);
+  walk_trapezoid(*p, *q, row_mid, row_bottom, area, out);
   out.flush();
 }
 
