@@ -40,7 +40,9 @@ int compare(const Image& got, const Image& want, const std::string& diff_path) {
     for (int c = 0; c < 3; ++c) diff.rgba[i + c] = out ? (c == 0 ? 255 : 0) : want.rgba[i + c] / 3;
     diff.rgba[i + 3] = 255;
   }
-  if (bad) EXPECT_TRUE(save_image(diff_path, diff).ok());
+  if (bad) {
+    EXPECT_TRUE(save_image(diff_path, diff).ok());
+  }
   return bad;
 }
 

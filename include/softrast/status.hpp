@@ -32,8 +32,11 @@ class [[nodiscard]] Status {
 template <class T>
 class [[nodiscard]] Result {
  public:
-  Result(T value) : value_(std::move(value)) {}        // NOLINT: implicit by design
-  Result(Status error) : status_(std::move(error)) {}  // NOLINT: implicit by design
+  Result(T value) : value_(std::move(value)) {}  // NOLINT: implicit by design
+  // Precondition: !error.ok() (an ok Status carries no value; it becomes an internal error).
+  Result(Status error)  // NOLINT: implicit by design
+      : status_(error.ok() ? Status::error("internal error: result without a value")
+                           : std::move(error)) {}
 
   bool ok() const { return value_.has_value(); }
   explicit operator bool() const { return ok(); }

@@ -1,6 +1,8 @@
 // raster/setup.cpp: edge functions, fill-rule bias, bounds and plane equations.
 #include "raster/setup.hpp"
 
+#include "core/check.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -93,6 +95,12 @@ int64_t signed_area_fx16(const WindowVertex& v0, const WindowVertex& v1, const W
 bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
                     int num_varyings, CullMode cull, FrontFace front_face, const PixelRect& scissor,
                     TriangleSetup& out) {
+  // Clipping keeps every vertex inside the guard band; the bit budget of the edge functions
+  // (fixed_point.hpp) depends on it.
+  for (const WindowVertex* v : {&v0, &v1, &v2}) {
+    SOFTRAST_CHECK_LT(std::llabs(v->x), kMaxCoordFx8);
+    SOFTRAST_CHECK_LT(std::llabs(v->y), kMaxCoordFx8);
+  }
   int64_t area = signed_area_fx16(v0, v1, v2);
   if (area == 0) return false;  // zero area: back-facing by convention, and covers nothing
   bool ccw = area < 0;          // counter-clockwise as seen in the image (y down)
