@@ -2,6 +2,7 @@
 // Row 0 is the top row (window y grows downwards), the same as Image.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -49,9 +50,9 @@ class Framebuffer {
 
 // Float colour to RGBA8 by the conventions: clamp to [0, 1], then x * 255 + 0.5 truncated.
 inline uint8_t to_unorm8(float x) {
-  if (!(x > 0.0f)) return 0;  // also maps NaN to 0
-  if (x >= 1.0f) return 255;
-  return static_cast<uint8_t>(x * 255.0f + 0.5f);
+  // max(0, NaN) is 0 (the comparison is false), so NaN maps to 0; no branches.
+  float clamped = std::min(1.0f, std::max(0.0f, x));
+  return static_cast<uint8_t>(clamped * 255.0f + 0.5f);
 }
 inline uint32_t pack_rgba8(glm::vec4 c) {
   return uint32_t(to_unorm8(c.r)) | uint32_t(to_unorm8(c.g)) << 8 | uint32_t(to_unorm8(c.b)) << 16 |

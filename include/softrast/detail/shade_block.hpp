@@ -138,7 +138,8 @@ void shade_quad(const S& shader, const ShadeTarget& target, const Interpolants& 
     }
     if (depth_test && st.depth_write) *depth = fi.depth;
     uint32_t* pixel = &fb.color_row(py)[px];
-    *pixel = blend_pixel(st.blend, color, *pixel);
+    *pixel =
+        st.blend == BlendMode::kOpaque ? pack_rgba8(color) : blend_pixel(st.blend, color, *pixel);
   }
 }
 
