@@ -203,7 +203,7 @@ TEST_F(CliTest, ExplicitCameraOverridesTheFraming) {
 TEST_F(CliTest, EveryRenderFlagIsAccepted) {
   const char* kRuns[] = {
       "quad.obj --shader gouraud --cull none --front-face cw --depth lequal --blend alpha "
-      "--alpha 0.5 --raster scanline --filter nearest --wrap clamp --wireframe "
+      "--alpha 0.5 --raster scanline --filter nearest --wrap clamp --wireframe --threads 1 "
       "--color 0.2,0.4,0.6 --fov 60 --near 0.5 --far 50 --eye 0,0,5 --target 0,0,0 --up 0,1,0",
       "quad.obj --ortho -2,2,-1.5,1.5 --near -1 --far 10 --shader normals --depth off",
       "quad.obj --shader texture --texture texture.png --wrap mirror --blend add",
@@ -236,11 +236,12 @@ TEST_F(CliTest, HelpMentionsEveryFlag) {
     EXPECT_EQ(r.exit_code, 0) << args;
     EXPECT_EQ(r.err, "") << args;
     for (const char* flag :
-         {"--size",  "--eye",    "--target",    "--up",      "--fov",    "--ortho", "--near",
-          "--far",   "--shader", "--wireframe", "--texture", "--color",  "--cull",  "--front-face",
-          "--depth", "--blend",  "--alpha",     "--raster",  "--filter", "--wrap",  "--frames",
-          "--quiet", "--help",   "--version",   "-o",        "MODEL",    "flat",    "gouraud",
-          "phong",   "normals",  "scanline",    "notequal",  "mirror"}) {
+         {"--size",    "--eye",        "--target", "--up",        "--fov",     "--ortho",
+          "--near",    "--far",        "--shader", "--wireframe", "--texture", "--color",
+          "--cull",    "--front-face", "--depth",  "--blend",     "--alpha",   "--raster",
+          "--filter",  "--wrap",       "--frames", "--threads",   "--quiet",   "--help",
+          "--version", "-o",           "MODEL",    "flat",        "gouraud",   "phong",
+          "normals",   "scanline",     "notequal", "mirror"}) {
       EXPECT_NE(r.out.find(flag), std::string::npos) << args << " does not mention " << flag;
     }
   }
@@ -356,6 +357,8 @@ const BadInput kBadInputs[] = {
     {"UnknownDepth", "--depth sometimes -o out.png"},
     {"UnknownBlend", "--blend multiply -o out.png"},
     {"UnknownRaster", "--raster raytrace -o out.png"},
+    {"NegativeThreads", "--threads -1 -o out.png"},
+    {"NonNumericThreads", "--threads many -o out.png"},
     {"UnknownFilter", "--filter trilinear -o out.png"},
     {"UnknownWrap", "--wrap border -o out.png"},
     {"FramesZero", "--frames 0 -o out.png"},

@@ -65,6 +65,10 @@ void define_state_flags(CLI::App& app, RawArgs& a) {
       ->type_name("MODE");
   app.add_option("--raster", a.raster, "Rasterizer: edge (tiles) or scanline (default edge)")
       ->type_name("ALGO");
+  app.add_option("--threads", a.threads,
+                 "Threads to render with: 0 for every core, 1 for the single-threaded reference "
+                 "path (default 0; the image is the same)")
+      ->type_name("N");
 }
 
 }  // namespace

@@ -25,6 +25,7 @@ struct RawArgs {
   std::string blend = "opaque";
   float alpha = 1.0f;
   std::string raster = "edge";
+  int threads = 0;
   std::string filter = "bilinear";
   std::string wrap = "repeat";
   std::optional<int> frames;

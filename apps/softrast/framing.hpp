@@ -1,5 +1,6 @@
 // apps/softrast/framing.hpp: the camera for a model when the command line does not give one:
-// look at the bounding box's centre from +z (from 45 degrees up for flat models), far enough that the bounding sphere fits the view.
+// look at the bounding box's centre from +z (from 45 degrees up for flat models), far enough that
+// the bounding sphere fits the view.
 #pragma once
 
 #include <optional>

@@ -99,6 +99,8 @@ std::string lowercase_extension(const std::string& path) {
   return ext;
 }
 
+constexpr int kMaxThreads = 1024;
+
 void interpret_state(const RawArgs& a, RenderState& state, FirstError& e) {
   e.take(lookup<CullMode>("--cull", kCullModes, a.cull), state.cull);
   e.take(lookup<FrontFace>("--front-face", kFrontFaces, a.front_face), state.front_face);
@@ -108,6 +110,9 @@ void interpret_state(const RawArgs& a, RenderState& state, FirstError& e) {
   state.depth_func = depth.func;
   e.take(lookup<BlendMode>("--blend", kBlendModes, a.blend), state.blend);
   e.take(lookup<RasterAlgorithm>("--raster", kRasterAlgorithms, a.raster), state.raster);
+  e.fail_if(a.threads < 0 || a.threads > kMaxThreads,
+            "--threads: must be in 0.." + std::to_string(kMaxThreads));
+  state.threads = a.threads;
 }
 
 void interpret_shading(const RawArgs& a, RenderOptions& options, FirstError& e) {

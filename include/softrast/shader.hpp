@@ -12,6 +12,7 @@
 // any vertex layout works. Varyings are interpolated perspective-correctly.
 #pragma once
 
+#include <algorithm>
 #include <concepts>
 #include <cstdint>
 #include <span>
@@ -20,6 +21,7 @@
 #include <glm/vec4.hpp>
 
 #include "softrast/detail/interpolants.hpp"
+#include "softrast/detail/parallel.hpp"
 #include "softrast/detail/shade_block.hpp"
 #include "softrast/framebuffer.hpp"
 #include "softrast/render_state.hpp"
@@ -40,16 +42,25 @@ concept ShaderProgram = requires(const S& s, uint32_t index, float* out, Fragmen
 // over vertices 0..vertex_count-1 into `framebuffer`. Runs the vertex shader once per vertex,
 // then clipping, culling, rasterization, depth test, the fragment shader and blending. Indices
 // >= vertex_count skip their primitive; primitives with NaN or Inf positions draw nothing.
+// vertex() and fragment() may run on several threads at once (state.threads), so they must not
+// write to shared data; every pixel still sees the primitives in submission order.
 template <ShaderProgram S>
 void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
           std::span<const uint32_t> indices, uint32_t vertex_count) {
   constexpr int kStride = 4 + S::kVaryings;
+  constexpr uint32_t kVerticesPerJob = 4096;
   std::vector<float> clip(size_t(vertex_count) * kStride);
-  for (uint32_t i = 0; i < vertex_count; ++i) {
-    float* v = &clip[size_t(i) * kStride];
-    glm::vec4 p = shader.vertex(i, v + 4);
-    v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = p.w;
-  }
+  auto shade_vertices = [&](size_t job) {
+    uint32_t end = uint32_t(std::min<size_t>(vertex_count, (job + 1) * kVerticesPerJob));
+    for (uint32_t i = uint32_t(job * kVerticesPerJob); i < end; ++i) {
+      float* v = &clip[size_t(i) * kStride];
+      glm::vec4 p = shader.vertex(i, v + 4);
+      v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = p.w;
+    }
+  };
+  size_t jobs = (size_t(vertex_count) + kVerticesPerJob - 1) / kVerticesPerJob;
+  detail::parallel_for(jobs, state.threads > 0 ? state.threads : detail::hardware_threads(),
+                       shade_vertices);
   detail::ClipVertices vertices{clip.data(), vertex_count, kStride, S::kVaryings};
   detail::FragmentProgram program{&detail::shade_block<S>, &shader};
   detail::draw_clip_space(framebuffer, state, vertices, indices.data(), indices.size(), program);
