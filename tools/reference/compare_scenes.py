@@ -1,0 +1,115 @@
+#!/usr/bin/env python3
+"""Runs the benchmark scenes of shared/bench/SCENES.md through softrast and the llvmpipe
+reference (glref) side by side: the same flags, the images compared with imgdiff, samples_passed
+against the figures of SCENES.md, and the median frame time of each (the median of RUNS runs'
+medians) for each thread count: softrast --threads N beside llvmpipe with LP_NUM_THREADS=N.
+
+usage: compare_scenes.py [--scenes DIR] [--build DIR] [--out DIR] [--runs N] [--threads 1,2]
+                         [--only NAME[,NAME...]]
+Build first with: cmake --preset release -DSOFTRAST_BUILD_REFERENCE=ON && cmake --build --preset
+release. Scenes: python3 ../shared/bench/gen_scenes.py DIR (the default DIR is /tmp/scenes).
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+
+CAMERAS = {
+    "spheres_1m": "--eye 0,0,21.73 --target 0,0,0 --up 0,1,0 --fov 45 --near 1 --far 100 "
+                  "--cull back --frames 10",
+    "overdraw": "--eye 0,0,10 --target 0,0,0 --up 0,1,0 --fov 45 --near 1 --far 100 "
+                "--cull back --frames 6",
+    "quad_grid": "--eye 0,6,6 --target 0,0,-1 --up 0,1,0 --fov 50 --near 0.5 --far 100 "
+                 "--cull back --frames 40",
+}
+# (scene, shader, textured) in the order of SCENES.md.
+CASES = [
+    ("spheres_1m", "flat", False), ("spheres_1m", "gouraud", False),
+    ("spheres_1m", "phong", False), ("spheres_1m", "texture", True),
+    ("overdraw", "flat", False), ("overdraw", "gouraud", False),
+    ("overdraw", "texture", True), ("overdraw", "phong", True),
+    ("quad_grid", "texture", True), ("quad_grid", "phong", True),
+]
+# samples_passed that SCENES.md states.
+EXPECTED_SAMPLES = {"overdraw": 106166512, "quad_grid": 2073600}
+THRESHOLD = {"flat": 3, "gouraud": 3, "texture": 8, "phong": 8}
+
+
+def run_json(command, env):
+    result = subprocess.run(command, env=env, capture_output=True, text=True, check=False)
+    if result.returncode != 0:
+        sys.exit("failed: %s\n%s" % (" ".join(command), result.stderr))
+    return json.loads(result.stdout.strip().splitlines()[-1])
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    root = os.path.dirname(os.path.dirname(here))
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--scenes", default="/tmp/scenes")
+    parser.add_argument("--build", default=os.path.join(root, "build", "release"))
+    parser.add_argument("--out", default="/tmp/compare_scenes")
+    parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--threads", default="1,2")
+    parser.add_argument("--only", default="")
+    args = parser.parse_args()
+    softrast = os.path.join(args.build, "softrast")
+    glref = os.path.join(args.build, "tools", "reference", "glref")
+    imgdiff = os.path.join(args.build, "tools", "reference", "imgdiff")
+    threads = [t for t in args.threads.split(",") if t]
+    only = set(filter(None, args.only.split(",")))
+    os.makedirs(args.out, exist_ok=True)
+    rows = []
+    for scene, shader, textured in CASES:
+        name = "%s_%s" % (scene, shader)
+        if only and scene not in only and name not in only:
+            continue
+        flags = ["%s/%s.obj" % (args.scenes, scene), "--size", "1920x1080"]
+        flags += CAMERAS[scene].split() + ["--shader", shader, "-q"]
+        if textured:
+            flags += ["--texture", "%s/checker.png" % args.scenes]
+        soft_png = os.path.join(args.out, name + "_softrast.png")
+        gl_png = os.path.join(args.out, name + "_llvmpipe.png")
+        env = dict(os.environ)
+        soft_ms, gl_ms, samples = {t: [] for t in threads}, {t: [] for t in threads}, None
+        for run in range(args.runs):
+            for t in threads:
+                first = run == 0 and t == threads[0]
+                out = ["-o", soft_png] if first else []
+                line = run_json([softrast] + flags + ["--threads", t] + out, env)
+                soft_ms[t].append(line["median_ms"])
+                out = ["-o", gl_png] if first else []
+                line = run_json([glref] + flags + out, dict(env, LP_NUM_THREADS=t))
+                gl_ms[t].append(line["median_ms"])
+                samples = line["samples_passed"]
+        diff = run_json([imgdiff, soft_png, gl_png, "--threshold", str(THRESHOLD[shader]),
+                         "--diff", os.path.join(args.out, name + "_diff.png")], env)
+        row = {"scene": scene, "shader": shader + ("+tex" if textured and shader == "phong" else ""),
+               "softrast_ms": {t: statistics.median(v) for t, v in soft_ms.items()},
+               "llvmpipe_ms": {t: statistics.median(v) for t, v in gl_ms.items()},
+               "samples_passed": samples, "expected_samples": EXPECTED_SAMPLES.get(scene),
+               "diff": diff, "softrast_runs": soft_ms, "llvmpipe_runs": gl_ms}
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+    print()
+    head = "| scene | shader | " + " | ".join(
+        "softrast ms (%s thr) | llvmpipe ms (%s thr)" % (t, t) for t in threads) + \
+        " | samples_passed (SCENES.md) | differing px | max diff | 3x3 mismatches | " \
+        "coverage diffs |"
+    print(head)
+    print("|" + "---|" * (head.count("|") - 1))
+    for r in rows:
+        d = r["diff"]
+        expected = r["expected_samples"]
+        print("| %s | %s | %s | %d%s | %.4f %% | %d | %d | %d |" % (
+            r["scene"], r["shader"],
+            " | ".join("%.1f | %.1f" % (r["softrast_ms"][t], r["llvmpipe_ms"][t])
+                       for t in threads), r["samples_passed"],
+            " (%d)" % expected if expected else "", 100 * d["differing_fraction"],
+            d["max_channel_diff"], d["mismatches_3x3"], d["coverage_diffs"]))
+
+
+if __name__ == "__main__":
+    main()
