@@ -8,6 +8,7 @@ packages=(
   libstb-dev                 # PNG/TGA/JPG decoding, PNG/TGA encoding
   libcli11-dev               # the command line
   libgtest-dev               # the test suite
+  libosmesa6-dev libgl-dev   # Mesa llvmpipe, the reference renderer of the difference tests
 )
 sudo=""
 if [ "$(id -u)" != 0 ]; then sudo="sudo"; fi
