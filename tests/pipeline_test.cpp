@@ -5,8 +5,10 @@
 #include "softrast/shader.hpp"  // first: the custom-shader header must compile on its own
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <random>
 #include <set>
 #include <string>
 #include <utility>
@@ -369,22 +371,47 @@ TEST_P(Pipeline, CullingAndFacing) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Lines: for an x-major segment, each column whose centre c lies in [x0, x1) (going right) or
-// (x1, x0] (going left) gets the pixel in row floor(y(c)); y-major the same with rows.
+// Lines: the diamond-exit rule by its definition (OpenGL 3.4.1, D3D "aliased lines"): pixel f
+// is drawn when the segment intersects its diamond |x - cx| + |y - cy| < 1/2, unless the
+// segment's end lies inside that diamond; the endpoints are first perturbed by (e, e^2) in GL's
+// y-up window coordinates, (e, -e^2) in these y-down ones, so that no tie remains. Brute force over
+// pixels: f(p) = |px - cx| + |py - cy| is convex and piecewise linear along the segment, so its
+// minimum is at an end or where the segment crosses x = cx or y = cy.
 
 using Pixel = std::pair<int, int>;
 
+double diamond_distance(glm::dvec2 p, glm::dvec2 centre) {
+  return std::abs(p.x - centre.x) + std::abs(p.y - centre.y);
+}
+
+bool segment_meets_diamond(glm::dvec2 a, glm::dvec2 b, glm::dvec2 c) {
+  double best = std::min(diamond_distance(a, c), diamond_distance(b, c));
+  for (int axis = 0; axis < 2; ++axis) {
+    if (a[axis] == b[axis]) continue;
+    double t = (c[axis] - a[axis]) / (b[axis] - a[axis]);
+    if (t > 0.0 && t < 1.0) best = std::min(best, diamond_distance(a + t * (b - a), c));
+  }
+  return best < 0.5;
+}
+
 std::vector<Pixel> expected_line(glm::dvec2 a, glm::dvec2 b) {
   bool x_major = std::abs(b.x - a.x) >= std::abs(b.y - a.y);
-  double u0 = x_major ? a.x : a.y, u1 = x_major ? b.x : b.y;
-  double v0 = x_major ? a.y : a.x, v1 = x_major ? b.y : b.x;
+  const glm::dvec2 perturbation(1.0e-5, -1.0e-10);
+  a += perturbation;
+  b += perturbation;
   std::vector<Pixel> out;
-  for (int i = -8; i < 64; ++i) {
-    double c = i + 0.5;
-    if (u1 > u0 ? !(c >= u0 && c < u1) : !(c <= u0 && c > u1)) continue;
-    int minor = int(std::floor(v0 + (c - u0) * (v1 - v0) / (u1 - u0)));
-    out.push_back(x_major ? Pixel{i, minor} : Pixel{minor, i});
+  for (int j = -8; j < 64; ++j) {
+    for (int i = -8; i < 64; ++i) {
+      glm::dvec2 c(i + 0.5, j + 0.5);
+      if (segment_meets_diamond(a, b, c) && !(diamond_distance(b, c) < 0.5)) out.push_back({i, j});
+    }
   }
+  // Along the major axis, so that consecutive pixels are neighbours.
+  std::sort(out.begin(), out.end(), [&](Pixel p, Pixel q) {
+    double dp = x_major ? p.first : p.second, dq = x_major ? q.first : q.second;
+    double dir = x_major ? b.x - a.x : b.y - a.y;
+    return dir > 0 ? dp < dq : dp > dq;
+  });
   return out;
 }
 
@@ -397,6 +424,64 @@ std::vector<int> draw_lines(int size, const RenderState& s, const std::vector<gl
   std::vector<uint32_t> idx(pts.size());
   for (size_t i = 0; i < idx.size(); ++i) idx[i] = uint32_t(i);
   return count_hits(size, size, s, clip, idx);
+}
+
+// The same definition in 80-bit long double for random short segments on the 1/256 grid, many
+// of them with exact ties (endpoints on pixel centres, pixel edges and diamond corners). The
+// perturbation (1e-9, -1e-15) is far below the smallest non-tie distance of such segments (about
+// 2e-6 px), yet its e^2 term is far above long double's resolution.
+using LPoint = std::array<long double, 2>;
+
+long double ldiamond(LPoint p, LPoint c) {
+  return std::fabs(p[0] - c[0]) + std::fabs(p[1] - c[1]);
+}
+
+std::set<Pixel> exact_line(LPoint a, LPoint b) {
+  const long double e = 1.0e-9L, e2 = 1.0e-15L;
+  a = {a[0] + e, a[1] - e2};
+  b = {b[0] + e, b[1] - e2};
+  std::set<Pixel> out;
+  for (int j = -2; j < 20; ++j) {
+    for (int i = -2; i < 20; ++i) {
+      LPoint c{i + 0.5L, j + 0.5L};
+      long double best = std::min(ldiamond(a, c), ldiamond(b, c));
+      for (int axis = 0; axis < 2; ++axis) {
+        if (a[axis] == b[axis]) continue;
+        long double t = (c[axis] - a[axis]) / (b[axis] - a[axis]);
+        if (t > 0 && t < 1) {
+          best = std::min(best, ldiamond({a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])}, c));
+        }
+      }
+      if (best < 0.5L && !(ldiamond(b, c) < 0.5L)) out.insert({i, j});
+    }
+  }
+  return out;
+}
+
+TEST_P(Pipeline, RandomShortLinesFollowTheDiamondExitDefinition) {
+  constexpr int kN = 16;
+  RenderState s = counting_state(GetParam());
+  s.primitive = Primitive::kLines;
+  std::mt19937 rng(11);
+  // Coordinates in 1/256 px; half of them snapped to a 1/2-pixel lattice to make ties common.
+  std::uniform_int_distribution<int> coord(2 * 256, 14 * 256), coarse(4, 28);
+  for (int n = 0; n < 3000; ++n) {
+    auto pick = [&] { return n % 2 ? coarse(rng) * 128 : coord(rng); };
+    int ax = pick(), ay = pick(), bx = pick(), by = pick();
+    if (ax == bx && ay == by) continue;
+    glm::dvec2 a(ax / 256.0, ay / 256.0), b(bx / 256.0, by / 256.0);
+    auto hits = draw_lines(kN, s, {a, b});
+    std::set<Pixel> want = exact_line({ax / 256.0L, ay / 256.0L}, {bx / 256.0L, by / 256.0L});
+    std::set<Pixel> got;
+    for (int y = 0; y < kN; ++y) {
+      for (int x = 0; x < kN; ++x) {
+        if (hits[size_t(y) * kN + x]) got.insert({x, y});
+        EXPECT_LE(hits[size_t(y) * kN + x], 1);
+      }
+    }
+    ASSERT_EQ(got, want) << "line " << ax << "," << ay << " -> " << bx << "," << by
+                         << " (1/256 px)";
+  }
 }
 
 TEST_P(Pipeline, LinesInAllEightOctants) {

@@ -133,11 +133,13 @@ bool setup_line(const WindowVertex& v0, const WindowVertex& v1, int num_varyings
   out.y0 = v0.y;
   out.x1 = v1.x;
   out.y1 = v1.y;
+  // The pixels containing the endpoints, and one more on every side for ties that the
+  // diamond-exit rule resolves towards a neighbour.
   PixelRect box;
-  box.x0 = int(floor_div(std::min(v0.x, v1.x), kSubpixelOne));
-  box.x1 = int(floor_div(std::max(v0.x, v1.x), kSubpixelOne)) + 1;
-  box.y0 = int(floor_div(std::min(v0.y, v1.y), kSubpixelOne));
-  box.y1 = int(floor_div(std::max(v0.y, v1.y), kSubpixelOne)) + 1;
+  box.x0 = int(floor_div(std::min(v0.x, v1.x), kSubpixelOne)) - 1;
+  box.x1 = int(floor_div(std::max(v0.x, v1.x), kSubpixelOne)) + 2;
+  box.y0 = int(floor_div(std::min(v0.y, v1.y), kSubpixelOne)) - 1;
+  box.y1 = int(floor_div(std::max(v0.y, v1.y), kSubpixelOne)) + 2;
   out.bounds = intersect(box, scissor);
   if (out.bounds.empty()) return false;
 

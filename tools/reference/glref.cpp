@@ -92,7 +92,7 @@ constexpr const char* kHelp =
     "  --up X,Y,Z          up direction (0,1,0)\n"
     "  --fov DEG           vertical field of view, gluPerspective (45)\n"
     "  --ortho L,R,B,T     glOrtho box instead of a perspective\n"
-    "  --shader NAME       flat, gouraud, texture, phong or normals (phong)\n"
+    "  --shader NAME       flat, gouraud, texture, phong, normals or wireframe (phong)\n"
     "  --texture PATH      PNG/TGA texture for texture and phong\n"
     "  --color R,G,B       albedo for flat, gouraud and phong (0.9,0.6,0.3)\n"
     "  --alpha A           output alpha (1)\n"
@@ -181,7 +181,7 @@ bool apply_flag(const std::string& flag, const std::string& value, Options& o) {
     std::vector<float> v = parse_floats(flag, value, 4);
     o.ortho = glm::vec4(v[0], v[1], v[2], v[3]);
   } else if (flag == "--shader") {
-    check_choice(flag, value, {"flat", "gouraud", "texture", "phong", "normals"});
+    check_choice(flag, value, {"flat", "gouraud", "texture", "phong", "normals", "wireframe"});
     o.shader = value;
   } else if (flag == "--texture") {
     o.texture = value;
@@ -542,7 +542,8 @@ GLuint compile(GLenum stage, const std::string& source) {
 }
 
 GLuint make_program(const std::string& shader_name) {
-  std::string define = shader_name;
+  // wireframe: the flat shader with glPolygonMode(GL_LINE) (set_state).
+  std::string define = shader_name == "wireframe" ? "flat" : shader_name;
   std::transform(define.begin(), define.end(), define.begin(),
                  [](unsigned char c) { return char(std::toupper(c)); });
   std::string header = "#version 330 core\n#define " + define + " 1\n";
@@ -690,6 +691,7 @@ void set_state(const Options& o) {
   }
   glDisable(GL_DITHER);
   glDisable(GL_MULTISAMPLE);
+  glPolygonMode(GL_FRONT_AND_BACK, o.shader == "wireframe" ? GL_LINE : GL_FILL);
   check_gl("set_state");
 }
 
