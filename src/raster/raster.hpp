@@ -33,8 +33,9 @@ void rasterize_triangle_edge_equations(const TriangleSetup& tri, const PixelRect
 void rasterize_triangle_scanline(const TriangleSetup& tri, const PixelRect& region,
                                  const BlockSink& sink);
 
-// Lines: one pixel per column (x-major) or row (y-major), the one whose centre line the segment
-// crosses, for every column whose centre lies in [start, end): the end pixel is not drawn.
+// Lines by OpenGL's diamond-exit rule (with its endpoint perturbation deciding ties): the pixels
+// whose diamond |x - cx| + |y - cy| < 1/2 the segment meets, except the one its end lies in, so
+// connected segments (wireframe edges) never hit their shared vertex twice.
 void rasterize_line(const LineSetup& line, const PixelRect& region, const BlockSink& sink);
 
 // The mask of a block that covers columns [c0, c1) and rows [r0, r1) (all within 0..4).
