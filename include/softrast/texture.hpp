@@ -63,6 +63,7 @@ class Texture {
 inline int Texture::wrap(Wrap mode, int i, int size) {
   switch (mode) {
     case Wrap::kRepeat: {
+      if ((size & (size - 1)) == 0) return i & (size - 1);  // power of two: no division
       int m = i % size;
       return m < 0 ? m + size : m;
     }
@@ -78,30 +79,33 @@ inline int Texture::wrap(Wrap mode, int i, int size) {
   return 0;
 }
 
-// Converts a texture coordinate scaled to texels into an int without undefined behaviour for
-// NaN or huge values (they land on texel 0 or far away, then wrap like any other index).
-inline int texel_floor(float x) {
-  if (!(x > -1.0e9f && x < 1.0e9f)) return 0;
-  return static_cast<int>(std::floor(x));
+// Splits a texture coordinate scaled to texels into floor(x) and the fraction x - floor(x),
+// without a library call, and without undefined behaviour for NaN or huge values (they land on
+// texel 0 with fraction 0, then wrap like any other index).
+inline int texel_floor(float x, float& fraction) {
+  if (!(x > -1.0e9f && x < 1.0e9f)) {
+    fraction = 0.0f;
+    return 0;
+  }
+  int i = static_cast<int>(x);  // truncates towards zero
+  if (float(i) > x) --i;
+  fraction = x - float(i);
+  return i;
 }
 
 inline glm::vec4 Texture::sample_nearest(const Sampler& s, glm::vec2 uv) const {
-  int i = wrap(s.wrap_u, texel_floor(uv.x * float(width_)), width_);
-  int j = wrap(s.wrap_v, texel_floor(uv.y * float(height_)), height_);
+  float unused;
+  int i = wrap(s.wrap_u, texel_floor(uv.x * float(width_), unused), width_);
+  int j = wrap(s.wrap_v, texel_floor(uv.y * float(height_), unused), height_);
   return texel(i, j);
 }
 
 inline glm::vec4 Texture::sample_bilinear(const Sampler& s, glm::vec2 uv) const {
   // Texel centres sit at half-integers, so shift by half a texel before splitting into the
   // integer texel and the fractional weight (GL_LINEAR).
-  float x = uv.x * float(width_) - 0.5f;
-  float y = uv.y * float(height_) - 0.5f;
-  int x0 = texel_floor(x);
-  int y0 = texel_floor(y);
-  float fx = x - std::floor(x);
-  float fy = y - std::floor(y);
-  if (!(fx >= 0.0f && fx <= 1.0f)) fx = 0.0f;  // NaN or huge input
-  if (!(fy >= 0.0f && fy <= 1.0f)) fy = 0.0f;
+  float fx, fy;
+  int x0 = texel_floor(uv.x * float(width_) - 0.5f, fx);
+  int y0 = texel_floor(uv.y * float(height_) - 0.5f, fy);
   int i0 = wrap(s.wrap_u, x0, width_), i1 = wrap(s.wrap_u, x0 + 1, width_);
   int j0 = wrap(s.wrap_v, y0, height_), j1 = wrap(s.wrap_v, y0 + 1, height_);
   glm::vec4 bottom = texel(i0, j0) * (1.0f - fx) + texel(i1, j0) * fx;
