@@ -35,9 +35,7 @@ using test::Expect;
 using test::FloorOracle;
 using test::WorldShader;
 
-std::string algorithm_name(const testing::TestParamInfo<RasterAlgorithm>& info) {
-  return info.param == RasterAlgorithm::kScanline ? "Scanline" : "EdgeEquations";
-}
+using test::algorithm_name;
 
 int total(const std::vector<int>& hits) {
   int n = 0;

@@ -658,9 +658,7 @@ TEST_P(Pipeline, DepthBiasAppliesToAllPrimitives) {
   }
 }
 
-std::string algorithm_name(const testing::TestParamInfo<RasterAlgorithm>& info) {
-  return info.param == RasterAlgorithm::kScanline ? "Scanline" : "EdgeEquations";
-}
+using test::algorithm_name;
 
 INSTANTIATE_TEST_SUITE_P(BothRasterizers, Pipeline,
                          testing::Values(RasterAlgorithm::kEdgeEquations,

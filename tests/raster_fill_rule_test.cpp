@@ -47,9 +47,7 @@ std::string pictures(const std::vector<int>& expected, const std::vector<int>& a
   return "expected:\n" + ascii_map(expected, kW, kH) + "actual:\n" + ascii_map(actual, kW, kH);
 }
 
-std::string algorithm_name(const testing::TestParamInfo<RasterAlgorithm>& info) {
-  return info.param == RasterAlgorithm::kScanline ? "Scanline" : "EdgeEquations";
-}
+using test::algorithm_name;
 
 class FillRule : public testing::TestWithParam<RasterAlgorithm> {
  public:

@@ -25,9 +25,7 @@ using test::Expect;
 using test::FloorOracle;
 using test::WorldShader;
 
-std::string algorithm_name(const testing::TestParamInfo<RasterAlgorithm>& info) {
-  return info.param == RasterAlgorithm::kScanline ? "Scanline" : "EdgeEquations";
-}
+using test::algorithm_name;
 
 class Watertight : public testing::TestWithParam<RasterAlgorithm> {};
 

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
 #include "raster/raster.hpp"
@@ -25,6 +26,11 @@
 #include "softrast/shader.hpp"
 
 namespace softrast::test {
+
+// Names the raster algorithm in parameterised test names (BothRasterizers/Foo/Scanline).
+inline std::string algorithm_name(const testing::TestParamInfo<RasterAlgorithm>& info) {
+  return info.param == RasterAlgorithm::kScanline ? "Scanline" : "EdgeEquations";
+}
 
 // ---------------------------------------------------------------------------------------------
 // Window coordinates <-> clip space.
