@@ -80,14 +80,19 @@ inline float eval_plane(const Plane& p, float dx, float dy) {
 // Shades the pixels of `quad_mask` (bit k = pixel (k & 1, k >> 1)) of the 2x2 quad at (x, y).
 // All four pixels are interpolated so that the shader gets derivatives, as GPUs do with helper
 // pixels.
-template <class S>
+// kCommon compiles the state most draws use (depth test less with writes, opaque, no shader
+// depth) with every branch on the state resolved at compile time.
+template <class S, bool kCommon>
 void shade_quad(const S& shader, const ShadeTarget& target, const Interpolants& in, int x, int y,
                 uint32_t quad_mask) {
   constexpr int kN = S::kVaryings > 0 ? S::kVaryings : 1;
   constexpr bool kLateDepth = WritesDepth<S>;
   Framebuffer& fb = *target.framebuffer;
   const RenderState& st = *target.state;
-  bool depth_test = st.depth_test;
+  const bool depth_test = kCommon || st.depth_test;
+  const DepthFunc depth_func = kCommon ? DepthFunc::kLess : st.depth_func;
+  const bool depth_write = kCommon || st.depth_write;
+  const BlendMode blend = kCommon ? BlendMode::kOpaque : st.blend;
 
   float dx[4], dy[4], z[4];
   for (int k = 0; k < 4; ++k) {
@@ -98,7 +103,7 @@ void shade_quad(const S& shader, const ShadeTarget& target, const Interpolants& 
   if (!kLateDepth && depth_test) {  // early depth test: the shader cannot change depth
     for (int k = 0; k < 4; ++k) {
       if ((quad_mask >> k & 1) &&
-          !depth_passes(st.depth_func, z[k], fb.depth_at(x + (k & 1), y + (k >> 1)))) {
+          !depth_passes(depth_func, z[k], fb.depth_at(x + (k & 1), y + (k >> 1)))) {
         quad_mask &= ~(1u << k);
       }
     }
@@ -134,12 +139,11 @@ void shade_quad(const S& shader, const ShadeTarget& target, const Interpolants& 
     if (kLateDepth) {
       fi.depth = std::clamp(fi.depth, 0.0f, 1.0f);
       if (!(fi.depth >= 0.0f)) fi.depth = 0.0f;  // NaN
-      if (depth_test && !depth_passes(st.depth_func, fi.depth, *depth)) continue;
+      if (depth_test && !depth_passes(depth_func, fi.depth, *depth)) continue;
     }
-    if (depth_test && st.depth_write) *depth = fi.depth;
+    if (depth_test && depth_write) *depth = fi.depth;
     uint32_t* pixel = &fb.color_row(py)[px];
-    *pixel =
-        st.blend == BlendMode::kOpaque ? pack_rgba8(color) : blend_pixel(st.blend, color, *pixel);
+    *pixel = blend == BlendMode::kOpaque ? pack_rgba8(color) : blend_pixel(blend, color, *pixel);
   }
 }
 
@@ -148,12 +152,20 @@ template <class S>
 void shade_block(const void* shader, const ShadeTarget& target, const Interpolants& interp, int x,
                  int y, uint32_t mask) {
   const S& s = *static_cast<const S*>(shader);
+  const RenderState& st = *target.state;
+  bool common = !WritesDepth<S> && st.depth_test && st.depth_func == DepthFunc::kLess &&
+                st.depth_write && st.blend == BlendMode::kOpaque;
   for (int q = 0; q < 4; ++q) {
     int qx = (q & 1) * 2, qy = (q >> 1) * 2;
     uint32_t row0 = (mask >> (4 * qy + qx)) & 3u;
     uint32_t row1 = (mask >> (4 * (qy + 1) + qx)) & 3u;
     uint32_t quad_mask = row0 | row1 << 2;
-    if (quad_mask) shade_quad(s, target, interp, x + qx, y + qy, quad_mask);
+    if (!quad_mask) continue;
+    if (common) {
+      shade_quad<S, true>(s, target, interp, x + qx, y + qy, quad_mask);
+    } else {
+      shade_quad<S, false>(s, target, interp, x + qx, y + qy, quad_mask);
+    }
   }
 }
 
