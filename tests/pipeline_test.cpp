@@ -667,3 +667,26 @@ INSTANTIATE_TEST_SUITE_P(BothRasterizers, Pipeline,
 
 }  // namespace
 }  // namespace softrast
+
+namespace softrast {
+namespace {
+
+// pack_rgba8 (vectorised where SSE2 exists) against to_unorm8 per channel, the conventions'
+// x * 255 + 0.5 truncated after clamping, on every tie, both clamps, NaN and infinities.
+TEST(ColourPacking, PackMatchesTheScalarConversionEverywhere) {
+  std::vector<float> values = {0.0f,  1.0f,   -0.0f,         -1.0f,        2.0f,
+                               1e30f, -1e30f, std::nanf(""), INFINITY,     -INFINITY,
+                               0.3f,  0.7f,   0.5f,          1.0f / 255.0f};
+  for (int k = 0; k <= 510; ++k) values.push_back(float(k) / 510.0f);  // every tie and step
+  for (float r : values) {
+    glm::vec4 c(r, 1.0f - r, r * 0.5f, r);
+    uint32_t want = uint32_t(to_unorm8(c.r)) | uint32_t(to_unorm8(c.g)) << 8 |
+                    uint32_t(to_unorm8(c.b)) << 16 | uint32_t(to_unorm8(c.a)) << 24;
+    ASSERT_EQ(pack_rgba8(c), want) << r;
+  }
+  EXPECT_EQ(to_unorm8(0.3f), 77);  // 76.5 rounds up (CONVENTIONS.md)
+  EXPECT_EQ(to_unorm8(std::nanf("")), 0);
+}
+
+}  // namespace
+}  // namespace softrast
