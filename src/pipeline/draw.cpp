@@ -74,10 +74,7 @@ void SerialDraw::wire_triangle(const WindowVertex& w0, const WindowVertex& w1,
                                const WindowVertex& w2) {
   int64_t area = signed_area_fx16(w0, w1, w2);
   if (area == 0 && state_.cull != CullMode::kNone) return;
-  bool front = (state_.front_face == FrontFace::kCounterClockwise) == (area < 0);
-  if ((state_.cull == CullMode::kBack && !front) || (state_.cull == CullMode::kFront && front)) {
-    return;
-  }
+  if (is_culled(area, state_.cull, state_.front_face)) return;
   line(w0, w1);
   line(w1, w2);
   line(w2, w0);

@@ -103,9 +103,8 @@ bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const Window
   }
   int64_t area = signed_area_fx16(v0, v1, v2);
   if (area == 0) return false;  // zero area: back-facing by convention, and covers nothing
-  bool ccw = area < 0;          // counter-clockwise as seen in the image (y down)
-  bool front = (front_face == FrontFace::kCounterClockwise) == ccw;
-  if ((cull == CullMode::kBack && !front) || (cull == CullMode::kFront && front)) return false;
+  if (is_culled(area, cull, front_face)) return false;
+  bool ccw = area < 0;  // counter-clockwise as seen in the image (y down)
 
   // Reorder to clockwise so that every edge function is positive inside.
   const WindowVertex* v[3] = {&v0, &v1, &v2};
@@ -121,7 +120,7 @@ bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const Window
     out.edge[k] = make_edge(out.vx[k], out.vy[k], out.vx[j], out.vy[j]);
   }
   setup_planes(v, num_varyings, std::abs(area), out.interp);
-  out.interp.front_facing = front;
+  out.interp.front_facing = is_front_facing(area, front_face);
   return true;
 }
 

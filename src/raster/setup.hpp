@@ -55,6 +55,16 @@ struct TriangleSetup {
 // In y-down window coordinates it is negative for counter-clockwise triangles.
 int64_t signed_area_fx16(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2);
 
+// Facing and culling from the sign of the snapped area (signed_area_fx16); zero area counts as
+// back-facing.
+inline bool is_front_facing(int64_t area, FrontFace front_face) {
+  return area != 0 && (front_face == FrontFace::kCounterClockwise) == (area < 0);
+}
+inline bool is_culled(int64_t area, CullMode cull, FrontFace front_face) {
+  bool front = is_front_facing(area, front_face);
+  return (cull == CullMode::kBack && !front) || (cull == CullMode::kFront && front);
+}
+
 // Culling and setup of one triangle. Returns false when the triangle is culled (zero area
 // counts as back-facing and is never drawn), or covers no pixel of `scissor`.
 bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
