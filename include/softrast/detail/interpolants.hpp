@@ -25,20 +25,30 @@ struct Plane {
 
 // Everything the fragment stage needs of one primitive. Depth is linear in window space; the
 // varyings are stored divided by w, so value = plane(var) / plane(inv_w) is perspective-correct.
+// `var` comes last and the fragment stage reads only var[0 .. num_varyings): a producer may keep
+// a record cut short after var[num_varyings - 1] (interpolants_bytes), as the bins do.
 struct Interpolants {
   float x_ref = 0.0f;
   float y_ref = 0.0f;
   Plane z;
   Plane inv_w;
-  Plane var[kMaxVaryings];
   int num_varyings = 0;
   bool front_facing = true;
+  Plane var[kMaxVaryings];
 };
 
-// Where fragments go.
+// Bytes of an Interpolants record that holds `num_varyings` planes.
+constexpr size_t interpolants_bytes(int num_varyings) {
+  return offsetof(Interpolants, var) + sizeof(Plane) * size_t(num_varyings);
+}
+
+// Where fragments go. With `resolved`, visibility has already been decided for the block (the
+// deferred path: depth test done, depth written): the mask holds exactly the pixels this
+// primitive won, and the fragment stage shades them and writes their colour, nothing else.
 struct ShadeTarget {
   Framebuffer* framebuffer = nullptr;
   const RenderState* state = nullptr;
+  bool resolved = false;
 };
 
 // Shades one 4x4 block of pixels whose top-left pixel is (x, y), both multiples of 4; bit
@@ -47,9 +57,13 @@ struct ShadeTarget {
 using ShadeBlockFn = void (*)(const void* shader, const ShadeTarget& target,
                               const Interpolants& interp, int x, int y, uint32_t mask);
 
+// `deferrable`: the shader neither discards nor writes depth, so with an opaque, depth-writing
+// less / less-equal state the image depends only on the nearest fragment of each pixel, and the
+// pipeline may resolve visibility first and shade each visible pixel once (ShadeTarget::resolved).
 struct FragmentProgram {
   ShadeBlockFn shade_block = nullptr;
   const void* shader = nullptr;
+  bool deferrable = false;
 };
 
 // The vertex stage's output: per vertex a clip-space position (x, y, z, w) followed by
