@@ -142,7 +142,8 @@ Buffers read_back(const Framebuffer& fb) {
 Buffers render(const std::vector<const Scene*>& scenes, RenderState state, int threads,
                bool reference) {
   Framebuffer fb(301, 187);  // not a multiple of the tile size
-  state.threads = reference ? 1 : threads;
+  state.threads = threads;
+  state.reference_path = reference;
   for (const Scene* s : scenes) {
     ColorShader shader{s->positions.data(), s->colors.data()};
     draw_deferrable(fb, state, shader, s->indices, uint32_t(s->positions.size()));
@@ -227,7 +228,7 @@ long count_shaded(const Scene& scene, const RenderState& state, int* visible = n
 
 TEST(Deferred, VisiblePixelsAreShadedOnceAndOnlyWhereAllowed) {
   Scene scene = layered_scene(16, true, 9);  // back to front: every layer passes everywhere
-  for (int threads : {2}) {
+  for (int threads : {1, 2}) {
     RenderState state = opaque_state(DepthFunc::kLess);
     state.threads = threads;
     int visible = 0;
