@@ -66,9 +66,11 @@ void define_state_flags(CLI::App& app, RawArgs& a) {
   app.add_option("--raster", a.raster, "Rasterizer: edge (tiles) or scanline (default edge)")
       ->type_name("ALGO");
   app.add_option("--threads", a.threads,
-                 "Threads to render with: 0 for every core, 1 for the single-threaded reference "
-                 "path (default 0; the image is the same)")
+                 "Threads to render with: 0 for every core (default 0; the image is the same)")
       ->type_name("N");
+  app.add_flag("--reference-path", a.reference_path,
+               "Render with the slow single-threaded immediate path that the tests use as the "
+               "oracle (same image)");
 }
 
 }  // namespace

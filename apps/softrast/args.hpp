@@ -26,6 +26,7 @@ struct RawArgs {
   float alpha = 1.0f;
   std::string raster = "edge";
   int threads = 0;
+  bool reference_path = false;
   std::string filter = "bilinear";
   std::string wrap = "repeat";
   std::optional<int> frames;

@@ -113,6 +113,7 @@ void interpret_state(const RawArgs& a, RenderState& state, FirstError& e) {
   e.fail_if(a.threads < 0 || a.threads > kMaxThreads,
             "--threads: must be in 0.." + std::to_string(kMaxThreads));
   state.threads = a.threads;
+  state.reference_path = a.reference_path;
 }
 
 void interpret_shading(const RawArgs& a, RenderOptions& options, FirstError& e) {

@@ -38,9 +38,12 @@ struct RenderState {
   // Added to every window depth before the depth test (like a polygon offset in depth units);
   // a small negative value lets a wireframe overlay win against its own filled surface.
   float depth_bias = 0.0f;
-  // Threads a draw may use: 0 for every hardware thread, 1 for the single-threaded reference
-  // path. The image is the same for every value.
+  // Threads a draw may use: 0 for every hardware thread. The image is the same for every value.
   int threads = 0;
+  // The slow, obviously correct oracle: one thread, every primitive set up, rasterized and shaded
+  // immediately in submission order (no binning, no deferred shading, `threads` ignored). The
+  // tests hold the fast paths to its image and depth bit for bit.
+  bool reference_path = false;
 };
 
 }  // namespace softrast

@@ -8,9 +8,11 @@
 // The image equals the single-threaded path's bit for bit: setup is the same function, and the
 // rasterizers give the same coverage whatever region a triangle is cut into.
 #include <algorithm>
+#include <memory>
 #include <vector>
 
 #include "pipeline/draw_internal.hpp"
+#include "pipeline/tile_visibility.hpp"
 #include "softrast/detail/parallel.hpp"
 
 namespace softrast::detail {
@@ -20,6 +22,34 @@ namespace {
 constexpr size_t kBatchTriangles = 16384;
 // Chunks per thread in the geometry phase, for load balance when clipping is uneven.
 constexpr int kChunksPerThread = 4;
+
+// A thread's scratch for deferred tiles, allocated once per thread and reused by every draw.
+struct DeferredScratch {
+  TileVisibility visibility;
+  std::vector<const Interpolants*> interps;  // by id: the tile's triangles in submission order
+};
+
+DeferredScratch& deferred_scratch() {
+  thread_local std::unique_ptr<DeferredScratch> scratch;
+  if (!scratch) scratch = std::make_unique<DeferredScratch>();
+  return *scratch;
+}
+
+// The rasterizer's blocks of one triangle into the tile's depth resolve.
+struct ResolveSink {
+  TileVisibility* visibility;
+  ResolveBlockFn kernel;
+  bool less_equal;
+  DepthPlaneRef plane;
+  int32_t id;
+
+  static void emit(void* self, int x, int y, uint32_t mask) {
+    auto* s = static_cast<ResolveSink*>(self);
+    TileVisibility& v = *s->visibility;
+    int b = v.block(x, y);
+    s->kernel(s->plane, x, y, mask, s->id, s->less_equal, v.depth[b], v.id[b]);
+  }
+};
 
 struct Chunk {
   std::vector<TriangleSetup> setups;
@@ -31,6 +61,8 @@ class BinnedDraw {
   BinnedDraw(const GeometryStage& geometry, const RenderState& state, const ShadeTarget& target,
              const FragmentProgram& program, int threads)
       : geometry_(geometry), state_(state), target_(target), program_(program), threads_(threads) {
+    deferred_ = deferred_shading_applies(state, program);
+    if (deferred_) resolve_kernel_ = resolve_block_kernel();
     const PixelRect& s = geometry.scissor();
     tiles_x_ = (s.x1 + kTileSize - 1) / kTileSize;
     tiles_y_ = (s.y1 + kTileSize - 1) / kTileSize;
@@ -48,8 +80,9 @@ class BinnedDraw {
         size_t end = std::min(first + count, begin + per_chunk);
         setup_chunk(chunks_[c], indices, begin, end);
       });
-      parallel_for(size_t(tiles_x_) * size_t(tiles_y_), threads_,
-                   [&](size_t tile) { raster_tile(tile); });
+      parallel_for(size_t(tiles_x_) * size_t(tiles_y_), threads_, [&](size_t tile) {
+        deferred_ ? resolve_and_shade_tile(tile) : raster_tile(tile);
+      });
     }
   }
 
@@ -83,10 +116,15 @@ class BinnedDraw {
     }
   }
 
-  void raster_tile(size_t tile) {
+  PixelRect tile_region(size_t tile) const {
     int tx = int(tile % size_t(tiles_x_)), ty = int(tile / size_t(tiles_x_));
     PixelRect region{tx * kTileSize, ty * kTileSize, (tx + 1) * kTileSize, (ty + 1) * kTileSize};
-    region = intersect(region, geometry_.scissor());
+    return intersect(region, geometry_.scissor());
+  }
+
+  // Immediate shading: every block of every triangle goes to the fragment stage as it comes.
+  void raster_tile(size_t tile) {
+    PixelRect region = tile_region(tile);
     Shading shading(program_, target_);
     for (const Chunk& chunk : chunks_) {
       for (uint32_t id : chunk.bins[tile]) {
@@ -96,8 +134,35 @@ class BinnedDraw {
     }
   }
 
+  // Deferred shading (tile_visibility.hpp): visibility of all the tile's triangles first, in
+  // submission order, then one shading call per block and winning triangle.
+  void resolve_and_shade_tile(size_t tile) {
+    PixelRect region = tile_region(tile);
+    DeferredScratch& scratch = deferred_scratch();
+    TileVisibility& visibility = scratch.visibility;
+    visibility.begin(*target_.framebuffer, region);
+    scratch.interps.clear();
+    ResolveSink sink{&visibility, resolve_kernel_, state_.depth_func == DepthFunc::kLessEqual, {}, 0};
+    for (const Chunk& chunk : chunks_) {
+      for (uint32_t id : chunk.bins[tile]) {
+        const TriangleSetup& tri = chunk.setups[id];
+        sink.plane = {tri.interp.x_ref, tri.interp.y_ref, tri.interp.z};
+        sink.id = int32_t(scratch.interps.size());
+        scratch.interps.push_back(&tri.interp);
+        rasterize_triangle(tri, state_.raster, region, BlockSink{&ResolveSink::emit, &sink});
+      }
+    }
+    visibility.store_depth();
+    ShadeTarget resolved = target_;
+    resolved.resolved = true;
+    shade_winners(visibility, scratch.interps.data(), program_, resolved);
+    visibility.reset();
+  }
+
   const GeometryStage& geometry_;
   const RenderState& state_;
+  bool deferred_ = false;
+  ResolveBlockFn resolve_kernel_ = nullptr;
   ShadeTarget target_;
   const FragmentProgram& program_;
   int threads_;

@@ -1,8 +1,8 @@
 // pipeline/draw.cpp: one draw call from clip-space vertices to shaded pixels: primitive
 // assembly, clipping, divide and viewport (GeometryStage), setup and culling, rasterization and
-// the fragment program. Filled triangles on several threads take the binned path
-// (binned_draw.cpp); everything else, and threads = 1, runs here in submission order: the
-// single-threaded reference the binned path must match pixel for pixel.
+// the fragment program. Filled triangles take the binned path (binned_draw.cpp), on the calling
+// thread alone when threads = 1; lines, points, wireframe and RenderState::reference_path run
+// here in submission order: the single-threaded reference the binned path must match bit for bit.
 #include "pipeline/draw_internal.hpp"
 #include "softrast/detail/parallel.hpp"
 #include "softrast/framebuffer.hpp"
@@ -104,7 +104,7 @@ void draw_clip_space(Framebuffer& framebuffer, const RenderState& state,
   GeometryStage geometry(framebuffer.width(), framebuffer.height(), state, vertices);
   ShadeTarget target{&framebuffer, &state};
   int threads = state.threads > 0 ? state.threads : hardware_threads();
-  if (threads > 1 && state.primitive == Primitive::kTriangles && !state.wireframe) {
+  if (!state.reference_path && state.primitive == Primitive::kTriangles && !state.wireframe) {
     draw_triangles_binned(geometry, state, target, program, indices, index_count, threads);
     return;
   }

@@ -1,0 +1,258 @@
+// Deferred shading in tiles (pipeline/tile_visibility.hpp) against the immediate single-threaded
+// reference path: colour and depth buffers bit for bit, on scenes built to break it (heavy
+// overdraw in both orders, exactly equal depths under LESS and LEQUAL, several draws into one
+// framebuffer, near-plane clipping), for one and two threads; and a counting shader that shows
+// deferral is really taken (each visible pixel shaded once) and really refused where it must be.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "softrast/shader.hpp"
+
+namespace softrast {
+namespace {
+
+// Clip-space positions with a colour per vertex; counts the pixels it shades when `shaded` is
+// set. Varying colours make every pixel's colour depend on which triangle won it.
+struct ColorShader {
+  static constexpr int kVaryings = 4;
+  const glm::vec4* positions;
+  const glm::vec4* colors;
+  std::atomic<long>* shaded = nullptr;
+  glm::vec4 vertex(uint32_t i, float* v) const {
+    v[0] = colors[i].r, v[1] = colors[i].g, v[2] = colors[i].b, v[3] = colors[i].a;
+    return positions[i];
+  }
+  bool fragment(FragmentInput& in, glm::vec4& out) const {
+    if (shaded) shaded->fetch_add(1, std::memory_order_relaxed);
+    out = in.vec4(0);
+    return true;
+  }
+};
+
+// The same, declaring that it writes depth (it writes the depth it was given): never deferrable.
+struct DepthWritingShader : ColorShader {
+  static constexpr bool kWritesDepth = true;
+};
+
+// Runs a scalar shader's fragment stage under the resolved contract: visibility is decided and
+// depth written, so it shades the mask with the depth test off (no test, no depth write), opaque.
+template <class S>
+void resolved_aware_shade_block(const void* shader, const detail::ShadeTarget& target,
+                                const detail::Interpolants& in, int x, int y, uint32_t mask) {
+  if (!target.resolved) return detail::shade_block<S>(shader, target, in, x, y, mask);
+  RenderState state = *target.state;
+  state.depth_test = false;
+  state.blend = BlendMode::kOpaque;
+  detail::ShadeTarget plain{target.framebuffer, &state, false};
+  detail::shade_block<S>(shader, plain, in, x, y, mask);
+}
+
+// draw<S>() with the fragment program marked deferrable exactly when the shader allows it (it
+// does not write depth; these scalar shaders never discard), so the pipeline's own decision is
+// what the tests see.
+template <class S>
+void draw_deferrable(Framebuffer& fb, const RenderState& state, const S& shader,
+                     const std::vector<uint32_t>& indices, uint32_t vertex_count) {
+  constexpr int kStride = 4 + S::kVaryings;
+  std::vector<float> clip(size_t(vertex_count) * kStride);
+  for (uint32_t i = 0; i < vertex_count; ++i) {
+    glm::vec4 p = shader.vertex(i, &clip[size_t(i) * kStride + 4]);
+    std::memcpy(&clip[size_t(i) * kStride], &p, sizeof(p));
+  }
+  detail::ClipVertices vertices{clip.data(), vertex_count, kStride, S::kVaryings};
+  detail::FragmentProgram program{&resolved_aware_shade_block<S>, &shader,
+                                  !detail::WritesDepth<S>};
+  detail::draw_clip_space(fb, state, vertices, indices.data(), indices.size(), program);
+}
+
+struct Scene {
+  std::vector<glm::vec4> positions, colors;
+  std::vector<uint32_t> indices;
+
+  void triangle(glm::vec4 a, glm::vec4 b, glm::vec4 c, glm::vec4 color) {
+    for (const glm::vec4& p : {a, b, c}) {
+      indices.push_back(uint32_t(positions.size()));
+      positions.push_back(p);
+      // Vary the colour per vertex so interpolation shows who won a pixel.
+      colors.push_back(color * (0.6f + 0.2f * float(positions.size() % 3)));
+    }
+  }
+};
+
+// `count` large triangles (most cover a good part of the image) at random depths, some with w
+// varying across the triangle, some crossing the near plane (z < -w) when `cross_near`.
+Scene overdraw_scene(int count, unsigned seed, bool cross_near) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> pos(-1.6f, 1.6f), unit(0.0f, 1.0f);
+  Scene scene;
+  for (int t = 0; t < count; ++t) {
+    glm::vec4 color(unit(rng), unit(rng), unit(rng), 1.0f);
+    glm::vec4 v[3];
+    for (glm::vec4& p : v) {
+      float w = 0.5f + 2.0f * unit(rng);
+      float z = cross_near ? -1.3f + 2.2f * unit(rng) : -0.9f + 1.8f * unit(rng);
+      p = glm::vec4(pos(rng) * w, pos(rng) * w, z * w, w);
+    }
+    scene.triangle(v[0], v[1], v[2], color);
+  }
+  return scene;
+}
+
+// Quads of constant depth covering the image, sorted by depth: back to front or front to back.
+Scene layered_scene(int layers, bool back_to_front, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> jitter(-0.2f, 0.2f), unit(0.0f, 1.0f);
+  Scene scene;
+  for (int k = 0; k < layers; ++k) {
+    int layer = back_to_front ? layers - 1 - k : k;
+    float z = -0.9f + 1.8f * float(layer) / float(layers);
+    float x0 = -0.9f + jitter(rng), x1 = 0.9f + jitter(rng);
+    float y0 = -0.9f + jitter(rng), y1 = 0.9f + jitter(rng);
+    glm::vec4 color(unit(rng), unit(rng), unit(rng), 1.0f);
+    glm::vec4 a(x0, y0, z, 1), b(x1, y0, z, 1), c(x1, y1, z, 1), d(x0, y1, z, 1);
+    scene.triangle(a, b, c, color);
+    scene.triangle(a, c, d, color);
+  }
+  return scene;
+}
+
+struct Buffers {
+  std::vector<uint32_t> color;
+  std::vector<float> depth;
+  bool operator==(const Buffers& o) const {
+    return color == o.color && depth.size() == o.depth.size() &&
+           std::memcmp(depth.data(), o.depth.data(), depth.size() * sizeof(float)) == 0;
+  }
+};
+
+Buffers read_back(const Framebuffer& fb) {
+  Buffers b;
+  for (int y = 0; y < fb.height(); ++y) {
+    b.color.insert(b.color.end(), fb.color_row(y), fb.color_row(y) + fb.width());
+    b.depth.insert(b.depth.end(), fb.depth_row(y), fb.depth_row(y) + fb.width());
+  }
+  return b;
+}
+
+// Draws each scene in turn (one draw call each) into one framebuffer.
+Buffers render(const std::vector<const Scene*>& scenes, RenderState state, int threads,
+               bool reference) {
+  Framebuffer fb(301, 187);  // not a multiple of the tile size
+  state.threads = threads;
+  state.reference_path = reference;
+  for (const Scene* s : scenes) {
+    ColorShader shader{s->positions.data(), s->colors.data()};
+    draw_deferrable(fb, state, shader, s->indices, uint32_t(s->positions.size()));
+  }
+  return read_back(fb);
+}
+
+void expect_same_as_reference(const std::vector<const Scene*>& scenes, const RenderState& state,
+                              const char* what) {
+  Buffers reference = render(scenes, state, 1, true);
+  for (int threads : {1, 2}) {
+    EXPECT_TRUE(render(scenes, state, threads, false) == reference)
+        << what << ", threads " << threads;
+  }
+}
+
+RenderState opaque_state(DepthFunc func) {
+  RenderState state;
+  state.cull = CullMode::kNone;
+  state.depth_func = func;
+  return state;
+}
+
+TEST(Deferred, HeavyOverdrawInBothOrdersEqualsReference) {
+  for (DepthFunc func : {DepthFunc::kLess, DepthFunc::kLessEqual}) {
+    for (bool back_to_front : {true, false}) {
+      Scene layers = layered_scene(48, back_to_front, 3);
+      expect_same_as_reference({&layers}, opaque_state(func), "layers");
+    }
+    Scene random = overdraw_scene(300, 11, false);
+    expect_same_as_reference({&random}, opaque_state(func), "random");
+  }
+}
+
+TEST(Deferred, EqualDepthsPickTheReferenceWinner) {
+  // Every triangle twice, at exactly the same depths, in a different colour: LESS keeps the
+  // first, LEQUAL the last, both within one draw and across two draws.
+  Scene first = overdraw_scene(60, 5, false), second = first;
+  for (glm::vec4& c : second.colors) c = glm::vec4(1.0f) - c;
+  Scene both = first;
+  for (size_t i = 0; i < second.indices.size(); ++i) {
+    both.indices.push_back(uint32_t(both.positions.size()));
+    both.positions.push_back(second.positions[i]);
+    both.colors.push_back(second.colors[i]);
+  }
+  for (DepthFunc func : {DepthFunc::kLess, DepthFunc::kLessEqual}) {
+    expect_same_as_reference({&both}, opaque_state(func), "one draw");
+    expect_same_as_reference({&first, &second}, opaque_state(func), "two draws");
+  }
+}
+
+TEST(Deferred, SeveralDrawsAndNearClippingEqualReference) {
+  Scene a = overdraw_scene(120, 21, true), b = layered_scene(20, false, 22),
+        c = overdraw_scene(120, 23, true);
+  for (DepthFunc func : {DepthFunc::kLess, DepthFunc::kLessEqual}) {
+    RenderState state = opaque_state(func);
+    expect_same_as_reference({&a, &b, &c}, state, "three draws");
+    state.cull = CullMode::kBack;
+    state.raster = RasterAlgorithm::kScanline;
+    expect_same_as_reference({&a, &b, &c}, state, "three draws, culled, scanline");
+  }
+}
+
+// Shades with a counting shader and returns how many pixels were shaded.
+template <class S>
+long count_shaded(const Scene& scene, const RenderState& state, int* visible = nullptr) {
+  std::atomic<long> shaded{0};
+  Framebuffer fb(256, 192);
+  S shader;
+  shader.positions = scene.positions.data();
+  shader.colors = scene.colors.data();
+  shader.shaded = &shaded;
+  draw_deferrable(fb, state, shader, scene.indices, uint32_t(scene.positions.size()));
+  if (visible) {
+    *visible = 0;
+    for (int y = 0; y < fb.height(); ++y) {
+      for (int x = 0; x < fb.width(); ++x) *visible += fb.depth_at(x, y) < 1.0f;
+    }
+  }
+  return shaded.load();
+}
+
+TEST(Deferred, VisiblePixelsAreShadedOnceAndOnlyWhereAllowed) {
+  Scene scene = layered_scene(16, true, 9);  // back to front: every layer passes everywhere
+  for (int threads : {1, 2}) {
+    RenderState state = opaque_state(DepthFunc::kLess);
+    state.threads = threads;
+    int visible = 0;
+    long deferred = count_shaded<ColorShader>(scene, state, &visible);
+    EXPECT_GT(visible, 0);
+    EXPECT_EQ(deferred, visible) << "threads " << threads;
+
+    // Each of these must shade every passing fragment: far more than the visible pixels.
+    long writes_depth = count_shaded<DepthWritingShader>(scene, state);
+    EXPECT_GT(writes_depth, 8 * long(visible)) << "threads " << threads;
+    for (BlendMode blend : {BlendMode::kAlpha, BlendMode::kAdditive}) {
+      RenderState blended = state;
+      blended.blend = blend;
+      EXPECT_GT(count_shaded<ColorShader>(scene, blended), 8 * long(visible));
+    }
+    RenderState no_write = state;
+    no_write.depth_write = false;
+    EXPECT_GT(count_shaded<ColorShader>(scene, no_write), 8 * long(visible));
+    RenderState greater = state;
+    greater.depth_func = DepthFunc::kGreater;
+    greater.depth_write = true;
+    EXPECT_EQ(count_shaded<ColorShader>(scene, greater), 0);  // nothing beats the clear depth 1
+  }
+}
+
+}  // namespace
+}  // namespace softrast
