@@ -8,6 +8,7 @@ packages=(
   libstb-dev                 # PNG/TGA/JPG decoding, PNG/TGA encoding
   libcli11-dev               # the command line
   libgtest-dev               # the test suite
+  libbenchmark-dev           # the micro-benchmarks (bench/), built but never run by the tests
   libosmesa6-dev libgl-dev   # Mesa llvmpipe, the reference renderer of the difference tests
 )
 sudo=""
