@@ -230,6 +230,18 @@ TEST_F(CliTest, TextureShaderShowsTheTexture) {
   EXPECT_EQ(pixel(image, 26, 26)[1], 255);
 }
 
+TEST_F(CliTest, UnsupportedTextureFormatIsOneErrorLine) {
+  // A 16-bit PGM header with no data: the old texture decoder (stb_image) read past its buffer
+  // converting it and the program died of SIGSEGV.
+  write("deep.pgm", "P5\n1000 1000\n65535\n");
+  CliRun r = run("quad.obj --texture deep.pgm -o out.png");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err,
+            "softrast: error: deep.pgm: unsupported image format (PNG, TGA and JPG are "
+            "supported)\n");
+  EXPECT_EQ(files(), fixtures_and({"deep.pgm"}));
+}
+
 TEST_F(CliTest, HelpMentionsEveryFlag) {
   for (const char* args : {"--help", "render --help", "-h"}) {
     CliRun r = run(args);
