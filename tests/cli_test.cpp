@@ -322,6 +322,7 @@ const BadInput kBadInputs[] = {
     {"GarbageTexture", "quad.obj --texture garbage.png -o out.png"},
     {"MissingTexture", "quad.obj --texture missing.png -o out.png"},
     {"TextureIsAnObj", "--texture quad.obj -o out.png"},
+    {"TextureIsDevZero", "quad.obj --texture /dev/zero -o out.png"},
     {"ZeroSize", "--size 0x100 -o out.png"},
     {"ZeroHeight", "--size 100x0 -o out.png"},
     {"NegativeSize", "--size=-5x10 -o out.png"},

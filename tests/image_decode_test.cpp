@@ -813,5 +813,31 @@ TEST(ImageDecode, MutatedFilesDecodeOrFailCleanly) {
   }
 }
 
+// ---- Files -----------------------------------------------------------------------------------
+
+TEST(ImageDecode, DevZeroAsAnImageFailsAtOnce) {
+  long before = peak_rss_kib();
+  Result<Image> image = load_image("/dev/zero");
+  ASSERT_FALSE(image.ok());
+  EXPECT_EQ(image.status().message(),
+            "/dev/zero: unsupported image format (PNG, TGA and JPG are supported)");
+  EXPECT_LT(peak_rss_kib() - before, 16 * 1024) << "read far more than the first bytes";
+}
+
+TEST(ImageDecode, FileLargerThanTheLimitIsRefusedUnread) {
+  // A sparse 600 MiB file that starts like a PNG: refused from its size, nothing read.
+  fs::path path = fs::temp_directory_path() / ("softrast_big_" + std::to_string(getpid()) + ".png");
+  { std::ofstream(path, std::ios::binary) << "\x89PNG\r\n\x1a\n"; }
+  fs::resize_file(path, uintmax_t(600) << 20);
+  long before = peak_rss_kib();
+  Result<Image> image = load_image(path.string());
+  long grown_kib = peak_rss_kib() - before;
+  fs::remove(path);
+  ASSERT_FALSE(image.ok());
+  EXPECT_EQ(image.status().message(),
+            path.string() + ": file is larger than 512 MiB, the limit for images");
+  EXPECT_LT(grown_kib, 16 * 1024);
+}
+
 }  // namespace
 }  // namespace softrast

@@ -20,6 +20,10 @@ inline constexpr int kMaxImageSize = 16384;
 // of compressed data can declare; images the library makes itself (framebuffers) are not capped.
 inline constexpr int64_t kMaxImagePixels = int64_t(1) << 26;
 
+// Largest file load_image reads (and buffer decode_image takes): 512 MiB, twice the largest RGBA8
+// image within kMaxImagePixels stored raw, so any sensible encoding of an accepted image fits.
+inline constexpr int64_t kMaxImageFileBytes = int64_t(512) << 20;
+
 // An 8-bit RGBA image, rows top to bottom, 4 bytes per pixel, no padding.
 struct Image {
   int width = 0;
@@ -36,7 +40,7 @@ struct Image {
 
 // Reads a PNG, TGA (bottom-up or top-down rows) or JPG file into RGBA8, top row first. The format
 // is told by the file's contents, not its name; any other format is an error. Errors name the
-// file: missing, unreadable, not one of the three formats,
+// file: missing, unreadable, larger than kMaxImageFileBytes, not one of the three formats,
 // truncated or corrupt (never a partly invented image), or wider or taller than kMaxImageSize or
 // with more than kMaxImagePixels pixels (refused from the header, before any pixel is allocated).
 Result<Image> load_image(const std::string& path);

@@ -2,6 +2,7 @@
 // and hands it to that format's decoder (io/*_decode.cpp); writing goes through stb_image_write
 // and a temporary file that is renamed over the target.
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -44,20 +45,57 @@ struct FileCloser {
 };
 using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
 
+// Bytes read before the format is decided: enough for every signature and the TGA header, so a
+// file that is not an image (or an endless device such as /dev/zero) is refused at once.
+constexpr size_t kSniffBytes = 64;
+constexpr size_t kReadBlock = size_t(1) << 16;
+
+std::string mib_text(int64_t bytes) {
+  return std::to_string(bytes >> 20) + " MiB";
+}
+
+Status too_large(const std::string& path) {
+  return fail(path,
+              "file is larger than " + mib_text(kMaxImageFileBytes) + ", the limit for images");
+}
+
+// Appends up to `limit` bytes more from f; false on a read error (errno says why).
+bool read_some(std::FILE* f, std::vector<uint8_t>& bytes, size_t limit) {
+  uint8_t buffer[kReadBlock];
+  while (limit > 0) {
+    size_t n = std::fread(buffer, 1, std::min(limit, sizeof buffer), f);
+    if (n == 0) break;
+    bytes.insert(bytes.end(), buffer, buffer + n);
+    limit -= n;
+  }
+  return !std::ferror(f);
+}
+
 Status unsupported(const std::string& name) {
   return fail(name, "unsupported image format (PNG, TGA and JPG are supported)");
 }
 
-// Reads the whole file; fails on open or read errors (including "is a directory").
+// Reads the whole file, at most kMaxImageFileBytes of it: a regular file's size is checked before
+// reading, anything else (pipes, devices) is cut off one byte past the limit. The first bytes
+// must look like a supported image before the rest is read. Fails on open or read errors
+// (including "is a directory").
 Status read_file(const std::string& path, std::vector<uint8_t>& bytes) {
   FilePtr f(std::fopen(path.c_str(), "rb"));
   if (!f) return fail(path, "cannot open: " + errno_text());
-  uint8_t buffer[1 << 16];
-  size_t n;
-  while ((n = std::fread(buffer, 1, sizeof buffer, f.get())) > 0) {
-    bytes.insert(bytes.end(), buffer, buffer + n);
+  struct stat info {};
+  if (fstat(fileno(f.get()), &info) == 0 && S_ISREG(info.st_mode)) {
+    if (info.st_size > kMaxImageFileBytes) return too_large(path);
+    bytes.reserve(size_t(info.st_size));
   }
-  if (std::ferror(f.get())) return fail(path, "cannot read: " + errno_text());
+  if (!read_some(f.get(), bytes, kSniffBytes)) return fail(path, "cannot read: " + errno_text());
+  if (!bytes.empty() && !detail::is_png(bytes.data(), bytes.size()) &&
+      !detail::is_jpeg(bytes.data(), bytes.size()) && !detail::is_tga(bytes.data(), bytes.size())) {
+    return unsupported(path);
+  }
+  if (!read_some(f.get(), bytes, size_t(kMaxImageFileBytes) + 1 - bytes.size())) {
+    return fail(path, "cannot read: " + errno_text());
+  }
+  if (bytes.size() > size_t(kMaxImageFileBytes)) return too_large(path);
   return {};
 }
 
@@ -138,6 +176,7 @@ Status check_image_size(const std::string& name, int64_t width, int64_t height) 
 
 Result<Image> decode_image(const uint8_t* data, size_t size, const std::string& name) {
   if (size == 0) return fail(name, "empty file");
+  if (size > size_t(kMaxImageFileBytes)) return too_large(name);
   // Signatures first; TGA has none, so it is last and only on a strictly valid header.
   if (detail::is_png(data, size)) return detail::decode_png(data, size, name);
   if (detail::is_jpeg(data, size)) return detail::decode_jpeg(data, size, name);
