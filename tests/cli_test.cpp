@@ -248,6 +248,18 @@ TEST_F(CliTest, LightFlagSetsTheWorldSpaceLightDirection) {
   EXPECT_GT(r_side, r_back);
 }
 
+TEST_F(CliTest, UnsupportedTextureFormatIsOneErrorLine) {
+  // A 16-bit PGM header with no data: the old texture decoder (stb_image) read past its buffer
+  // converting it and the program died of SIGSEGV.
+  write("deep.pgm", "P5\n1000 1000\n65535\n");
+  CliRun r = run("quad.obj --texture deep.pgm -o out.png");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err,
+            "softrast: error: deep.pgm: unsupported image format (PNG, TGA and JPG are "
+            "supported)\n");
+  EXPECT_EQ(files(), fixtures_and({"deep.pgm"}));
+}
+
 TEST_F(CliTest, HelpMentionsEveryFlag) {
   for (const char* args : {"--help", "render --help", "-h"}) {
     CliRun r = run(args);
@@ -329,6 +341,7 @@ const BadInput kBadInputs[] = {
     {"GarbageTexture", "quad.obj --texture garbage.png -o out.png"},
     {"MissingTexture", "quad.obj --texture missing.png -o out.png"},
     {"TextureIsAnObj", "--texture quad.obj -o out.png"},
+    {"TextureIsDevZero", "quad.obj --texture /dev/zero -o out.png"},
     {"ZeroSize", "--size 0x100 -o out.png"},
     {"ZeroHeight", "--size 100x0 -o out.png"},
     {"NegativeSize", "--size=-5x10 -o out.png"},
