@@ -1,11 +1,10 @@
-// pipeline/tile_visibility.cpp: the tile's depth and id scratch, the depth-resolve kernels (one
-// source, compiled for SSE2, AVX2 and AVX-512, picked at run time) and the shading of winners.
+// pipeline/tile_visibility.cpp: the tile's depth and id scratch and the shading of winners (the
+// resolve kernels are in tile_kernel.inl).
 #include "pipeline/tile_visibility.hpp"
 
 #include <algorithm>
 #include <cstring>
 
-#include "softrast/simd_level.hpp"
 
 namespace softrast::detail {
 
@@ -51,75 +50,6 @@ void TileVisibility::reset() {
       std::fill(id[b], id[b] + 16, kNoWinner);
     }
     touched[word] = 0;
-  }
-}
-
-namespace {
-
-// The kernel body, written once for N lanes (GCC vector extensions) and inlined into one wrapper
-// per instruction set; vectors never cross a call, so the wrappers' ABIs do not matter. The 16
-// pixels of the block are processed N at a time (lane l = 4 * row + column).
-template <int N>
-struct Lanes {
-  typedef float F __attribute__((vector_size(4 * N)));
-  typedef int32_t I __attribute__((vector_size(4 * N)));
-};
-
-template <int N, bool kLessEqual>
-[[gnu::always_inline]] inline void resolve_block_body(const DepthPlaneRef& p, int x, int y,
-                                                      uint32_t mask, int32_t id, float* depth,
-                                                      int32_t* ids) {
-  using F = typename Lanes<N>::F;
-  using I = typename Lanes<N>::I;
-  for (int g = 0; g < 16; g += N) {
-    I lane;
-    for (int i = 0; i < N; ++i) lane[i] = g + i;
-    // Exactly the fragment stage's depth: dx = float(px) + 0.5 - x_ref, then
-    // z = clamp((a0 + dadx * dx) + dady * dy, 0, 1) with std::clamp's NaN and -0 behaviour.
-    F dx = (__builtin_convertvector((lane & 3) + x, F) + 0.5f) - p.x_ref;
-    F dy = (__builtin_convertvector((lane >> 2) + y, F) + 0.5f) - p.y_ref;
-    F z = (p.z.a0 + p.z.dadx * dx) + p.z.dady * dy;
-    F zero = F{} + 0.0f, one = F{} + 1.0f;
-    z = (one < z) ? one : z;
-    z = (z < zero) ? zero : z;
-    F stored;
-    I winner;
-    std::memcpy(&stored, depth + g, sizeof(F));
-    std::memcpy(&winner, ids + g, sizeof(I));
-    I covered = ((int32_t(mask) >> lane) & 1) != 0;
-    I pass = (kLessEqual ? (z <= stored) : (z < stored)) & covered;
-    stored = pass ? z : stored;
-    winner = pass ? (I{} + id) : winner;
-    std::memcpy(depth + g, &stored, sizeof(F));
-    std::memcpy(ids + g, &winner, sizeof(I));
-  }
-}
-
-#define SOFTRAST_RESOLVE_KERNEL(name, lanes, target_attr)                                     \
-  target_attr void name(const DepthPlaneRef& p, int x, int y, uint32_t mask, int32_t id,       \
-                        bool less_equal, float* depth, int32_t* ids) {                         \
-    if (less_equal) {                                                                          \
-      resolve_block_body<lanes, true>(p, x, y, mask, id, depth, ids);                          \
-    } else {                                                                                   \
-      resolve_block_body<lanes, false>(p, x, y, mask, id, depth, ids);                         \
-    }                                                                                          \
-  }
-SOFTRAST_RESOLVE_KERNEL(resolve_block_sse2, 4, )
-SOFTRAST_RESOLVE_KERNEL(resolve_block_avx2, 8, __attribute__((target("avx2"))))
-SOFTRAST_RESOLVE_KERNEL(resolve_block_avx512, 16,
-                        __attribute__((target("avx512f,avx512bw,avx512dq,avx512vl"))))
-#undef SOFTRAST_RESOLVE_KERNEL
-
-}  // namespace
-
-ResolveBlockFn resolve_block_kernel() {
-  switch (simd_level()) {
-    case SimdLevel::kAvx512:
-      return &resolve_block_avx512;
-    case SimdLevel::kAvx2:
-      return &resolve_block_avx2;
-    default:
-      return &resolve_block_sse2;
   }
 }
 

@@ -92,26 +92,28 @@ int64_t signed_area_fx16(const WindowVertex& v0, const WindowVertex& v1, const W
          (int64_t(v2.x) - v0.x) * (int64_t(v1.y) - v0.y);
 }
 
-bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
-                    int num_varyings, CullMode cull, FrontFace front_face, const PixelRect& scissor,
-                    TriangleSetup& out) {
+bool setup_triangle_coverage(const WindowVertex& v0, const WindowVertex& v1,
+                             const WindowVertex& v2, CullMode cull, FrontFace front_face,
+                             const PixelRect& scissor, TriangleCoverage& out,
+                             const WindowVertex* ordered[3], int64_t& area) {
   // Clipping keeps every vertex inside the guard band; the bit budget of the edge functions
   // (fixed_point.hpp) depends on it.
   for (const WindowVertex* v : {&v0, &v1, &v2}) {
     SOFTRAST_CHECK_LT(std::llabs(v->x), kMaxCoordFx8);
     SOFTRAST_CHECK_LT(std::llabs(v->y), kMaxCoordFx8);
   }
-  int64_t area = signed_area_fx16(v0, v1, v2);
+  area = signed_area_fx16(v0, v1, v2);
   if (area == 0) return false;  // zero area: back-facing by convention, and covers nothing
   if (is_culled(area, cull, front_face)) return false;
   bool ccw = area < 0;  // counter-clockwise as seen in the image (y down)
 
   // Reorder to clockwise so that every edge function is positive inside.
-  const WindowVertex* v[3] = {&v0, &v1, &v2};
-  if (ccw) std::swap(v[1], v[2]);
+  ordered[0] = &v0;
+  ordered[1] = ccw ? &v2 : &v1;
+  ordered[2] = ccw ? &v1 : &v2;
   for (int k = 0; k < 3; ++k) {
-    out.vx[k] = v[k]->x;
-    out.vy[k] = v[k]->y;
+    out.vx[k] = ordered[k]->x;
+    out.vy[k] = ordered[k]->y;
   }
   out.bounds = intersect(triangle_bounds(out.vx, out.vy), scissor);
   if (out.bounds.empty()) return false;
@@ -119,8 +121,24 @@ bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const Window
     int j = (k + 1) % 3;
     out.edge[k] = make_edge(out.vx[k], out.vy[k], out.vx[j], out.vy[j]);
   }
-  setup_planes(v, num_varyings, std::abs(area), out.interp);
-  out.interp.front_facing = is_front_facing(area, front_face);
+  return true;
+}
+
+void setup_triangle_interpolants(const WindowVertex* const ordered[3], int num_varyings,
+                                 int64_t area, FrontFace front_face, Interpolants& out) {
+  setup_planes(ordered, num_varyings, std::abs(area), out);
+  out.front_facing = is_front_facing(area, front_face);
+}
+
+bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
+                    int num_varyings, CullMode cull, FrontFace front_face, const PixelRect& scissor,
+                    TriangleSetup& out) {
+  const WindowVertex* ordered[3];
+  int64_t area = 0;
+  if (!setup_triangle_coverage(v0, v1, v2, cull, front_face, scissor, out, ordered, area)) {
+    return false;
+  }
+  setup_triangle_interpolants(ordered, num_varyings, area, front_face, out.interp);
   return true;
 }
 
