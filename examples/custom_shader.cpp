@@ -11,9 +11,12 @@
 
 namespace {
 
-// The shader: reads positions by index, passes (u, v) to the fragment stage.
+// The shader: reads positions by index, passes (u, v) to the fragment stage. The fragment shader
+// is written once for a 4x4 block of pixels (softrast::simd types hold one value per pixel) and
+// softrast compiles it for SSE2, SSE4, AVX2 and AVX-512, running the widest the CPU has.
 struct CheckerHole {
   static constexpr int kVaryings = 2;
+  static constexpr bool kDiscards = true;  // it calls f.discard()
   const glm::vec3* positions;
   const glm::vec2* uvs;
   glm::mat4 mvp;
@@ -23,12 +26,17 @@ struct CheckerHole {
     varyings[1] = uvs[i].y;
     return mvp * glm::vec4(positions[i], 1.0f);
   }
-  bool fragment(softrast::FragmentInput& in, glm::vec4& color) const {
-    glm::vec2 uv = in.vec2(0);
-    if (glm::length(uv - glm::vec2(0.5f)) < 0.2f) return false;  // discard: a hole
-    bool odd = (int(uv.x * 8.0f) + int(uv.y * 8.0f)) % 2 != 0;
-    color = odd ? glm::vec4(0.9f, 0.5f, 0.2f, 1.0f) : glm::vec4(0.2f, 0.3f, 0.5f, 1.0f);
-    return true;
+
+  template <int N>
+  void shade(softrast::Fragments<N>& f) const {
+    using F = softrast::simd::Float<N>;
+    using I = softrast::simd::Int<N>;
+    F du = f.varying(0) - 0.5f, dv = f.varying(1) - 0.5f;
+    f.discard(du * du + dv * dv < F(0.04f));  // a hole of radius 0.2
+    I cells = softrast::simd::to_int(f.varying(0) * 8.0f) + softrast::simd::to_int(f.varying(1) * 8.0f);
+    I odd = (cells & I(1)) == I(1);
+    f.color = {select(odd, F(0.9f), F(0.2f)), select(odd, F(0.5f), F(0.3f)),
+               select(odd, F(0.2f), F(0.5f)), F(1.0f)};
   }
 };
 

@@ -2,6 +2,8 @@
 
 #include "run.hpp"
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -10,6 +12,7 @@
 
 #include "softrast/image.hpp"
 #include "softrast/renderer.hpp"
+#include "softrast/simd_level.hpp"
 
 namespace softrast::cli {
 namespace {
@@ -70,6 +73,13 @@ std::string json_string(const std::string& text) {
   return out + "\"";
 }
 
+// The process's peak resident memory so far, in MiB (Linux reports ru_maxrss in KiB).
+double peak_rss_mib() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
+  return double(usage.ru_maxrss) / 1024.0;
+}
+
 std::string json_line(const Job& job, const FrameStats& s) {
   // A clock too coarse for the frame would give a zero median; the rates stay finite numbers.
   double seconds = std::max(s.median_ms, 1e-6) / 1000.0;
@@ -84,7 +94,9 @@ std::string json_line(const Job& job, const FrameStats& s) {
          ",\"median_ms\":" + format("%.3f", s.median_ms) +
          ",\"min_ms\":" + format("%.3f", s.min_ms) + ",\"max_ms\":" + format("%.3f", s.max_ms) +
          ",\"mtris_per_s\":" + format("%.3f", triangles / seconds / 1e6) +
-         ",\"mpix_per_s\":" + format("%.3f", pixels / seconds / 1e6) + "}";
+         ",\"mpix_per_s\":" + format("%.3f", pixels / seconds / 1e6) +
+         ",\"simd\":" + json_string(simd_level_name(simd_level())) +
+         ",\"peak_rss_mib\":" + format("%.1f", peak_rss_mib()) + "}";
 }
 
 Status benchmark(Job& job) {

@@ -4,9 +4,17 @@
 // A shader is any type with:
 //   static constexpr int kVaryings = N;               // 0..16 floats from vertex to fragment
 //   glm::vec4 vertex(uint32_t index, float* varyings) const;   // clip-space position; writes N
-//   bool fragment(FragmentInput& in, glm::vec4& color) const;  // false discards the pixel
-// and optionally `static constexpr bool kWritesDepth = true;` when fragment() sets in.depth
-// (this turns the early depth test into a late one).
+// and a fragment shader, in one of two forms:
+//   template <int N> void shade(Fragments<N>& f) const;  // wide: a 4x4 block at once (fast)
+//   bool fragment(FragmentInput& in, glm::vec4& color) const;  // scalar: one pixel, false discards
+// The wide form is written with softrast::simd types (simd.hpp) as if for one pixel: f.vec3(0)
+// is a varying for all 16 pixels, f.color the output; it is compiled for SSE2, SSE4, AVX2 and
+// AVX-512 and the widest the CPU has runs. Optional traits:
+//   static constexpr bool kWritesDepth = true;  // the shader sets the depth: late depth test
+//   static constexpr bool kDiscards = true;     // a wide shader that calls f.discard()
+// A wide shader that neither writes depth nor discards lets opaque depth-tested draws resolve
+// visibility first and shade each visible pixel once (deferred shading in tiles).
+// A scalar shader is taken to discard (it returns a bool) and is always shaded immediately.
 //
 // The vertex shader pulls its own inputs by index (from whatever arrays the shader holds), so
 // any vertex layout works. Varyings are interpolated perspective-correctly.
@@ -23,6 +31,8 @@
 #include "softrast/detail/interpolants.hpp"
 #include "softrast/detail/parallel.hpp"
 #include "softrast/detail/shade_block.hpp"
+#include "softrast/detail/shade_simd.hpp"
+#include "softrast/detail/texture_simd.hpp"
 #include "softrast/framebuffer.hpp"
 #include "softrast/render_state.hpp"
 
@@ -30,12 +40,18 @@ namespace softrast {
 
 inline constexpr int kMaxVaryings = detail::kMaxVaryings;
 
+namespace detail {
 template <class S>
-concept ShaderProgram = requires(const S& s, uint32_t index, float* out, FragmentInput& in,
-                                 glm::vec4& color) {
+concept ScalarShader = requires(const S& s, FragmentInput& in, glm::vec4& color) {
+  { s.fragment(in, color) } -> std::convertible_to<bool>;
+};
+}  // namespace detail
+
+template <class S>
+concept ShaderProgram = requires(const S& s, uint32_t index, float* out) {
   requires S::kVaryings >= 0 && S::kVaryings <= kMaxVaryings;
   { s.vertex(index, out) } -> std::convertible_to<glm::vec4>;
-  { s.fragment(in, color) } -> std::convertible_to<bool>;
+  requires detail::WideShader<S> || detail::ScalarShader<S>;
 };
 
 // Draws `indices` (three per triangle, two per line, one per point, as state.primitive says)
@@ -62,7 +78,14 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
   detail::parallel_for(jobs, state.threads > 0 ? state.threads : detail::hardware_threads(),
                        shade_vertices);
   detail::ClipVertices vertices{clip.data(), vertex_count, kStride, S::kVaryings};
-  detail::FragmentProgram program{&detail::shade_block<S>, &shader};
+  detail::FragmentProgram program;
+  program.shader = &shader;
+  if constexpr (detail::WideShader<S>) {
+    program.shade_block = detail::wide_shade_block<S>(simd_level());
+    program.deferrable = !detail::WritesDepth<S> && !detail::DeclaresDiscards<S>;
+  } else {
+    program.shade_block = &detail::shade_block<S>;
+  }
   detail::draw_clip_space(framebuffer, state, vertices, indices.data(), indices.size(), program);
 }
 

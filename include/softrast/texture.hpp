@@ -34,6 +34,8 @@ class Texture {
   int width() const { return width_; }
   int height() const { return height_; }
   bool empty() const { return texels_.empty(); }
+  // The texels, rows bottom-up, RGBA8 (width * height * 4 bytes).
+  const uint8_t* texels() const { return texels_.data(); }
   // Texel (i, j), j counted from the bottom row; precondition: in range.
   glm::vec4 texel(int i, int j) const {
     const uint8_t* t = &texels_[(size_t(j) * size_t(width_) + size_t(i)) * 4];
@@ -49,8 +51,10 @@ class Texture {
     return sample_bilinear(s, uv);
   }
 
- private:
+  // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
   static int wrap(Wrap mode, int i, int size);
+
+ private:
   glm::vec4 sample_nearest(const Sampler& s, glm::vec2 uv) const;
   glm::vec4 sample_bilinear(const Sampler& s, glm::vec2 uv) const;
 

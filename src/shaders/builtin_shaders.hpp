@@ -1,5 +1,6 @@
 // shaders/builtin_shaders.hpp: the built-in shaders as types for softrast::draw. Each pulls its
-// vertex inputs from a Mesh by index. Formulas and constants are those of SCENES.md.
+// vertex inputs from a Mesh by index. Formulas and constants are those of SCENES.md. Fragment
+// shaders are wide (a 4x4 block per call, see softrast/shader.hpp), except the depth view's.
 #pragma once
 
 #include <algorithm>
@@ -31,9 +32,9 @@ struct FlatShader {
   MeshInputs in;
   glm::vec4 color;
   glm::vec4 vertex(uint32_t i, float*) const { return in.clip(i); }
-  bool fragment(FragmentInput&, glm::vec4& out) const {
-    out = color;
-    return true;
+  template <int N>
+  void shade(Fragments<N>& f) const {
+    f.color = {color.r, color.g, color.b, color.a};
   }
 };
 
@@ -49,9 +50,9 @@ struct GouraudShader {
     v[0] = c.r, v[1] = c.g, v[2] = c.b;
     return in.clip(i);
   }
-  bool fragment(FragmentInput& f, glm::vec4& out) const {
-    out = glm::vec4(f.vec3(0), alpha);
-    return true;
+  template <int N>
+  void shade(Fragments<N>& f) const {
+    f.color = {f.varying(0), f.varying(1), f.varying(2), alpha};
   }
 };
 
@@ -65,10 +66,10 @@ struct TextureShader {
     v[0] = in.mesh->uvs[i].x, v[1] = in.mesh->uvs[i].y;
     return in.clip(i);
   }
-  bool fragment(FragmentInput& f, glm::vec4& out) const {
-    glm::vec4 t = texture->sample(sampler, f.vec2(0));
-    out = glm::vec4(glm::vec3(t), t.a * alpha);
-    return true;
+  template <int N>
+  void shade(Fragments<N>& f) const {
+    simd::Vec4<N> t = sample<N>(*texture, sampler, f.vec2(0));
+    f.color = {t.x, t.y, t.z, t.w * alpha};
   }
 };
 
@@ -89,16 +90,27 @@ struct PhongShader {
     v[7] = uv.y;
     return in.clip(i);
   }
-  bool fragment(FragmentInput& f, glm::vec4& out) const {
-    glm::vec3 n = glm::normalize(f.vec3(3));
-    glm::vec3 view = glm::normalize(eye - f.vec3(0));
-    glm::vec3 h = glm::normalize(light + view);
-    float d = std::max(glm::dot(n, light), 0.0f);
-    float s = d > 0.0f ? std::pow(std::max(glm::dot(n, h), 0.0f), kShininess) : 0.0f;
-    glm::vec4 base(albedo, 1.0f);
-    if (texture) base = texture->sample(sampler, f.vec2(6));
-    out = glm::vec4(glm::vec3(base) * (kAmbient + kDiffuse * d) + kSpecular * s, base.a * alpha);
-    return true;
+  template <int N>
+  void shade(Fragments<N>& f) const {
+    using F = simd::Float<N>;
+    simd::Vec3<N> n = simd::normalize(f.vec3(3));
+    simd::Vec3<N> view = simd::normalize(simd::splat3<N>(eye) - f.vec3(0));
+    simd::Vec3<N> l = simd::splat3<N>(light);
+    simd::Vec3<N> h = simd::normalize(l + view);
+    F d = simd::max(simd::dot(n, l), F(0.0f));
+    F s = simd::select(d > F(0.0f), pow_shininess(simd::max(simd::dot(n, h), F(0.0f))), F(0.0f));
+    simd::Vec4<N> base{F(albedo.r), F(albedo.g), F(albedo.b), F(1.0f)};
+    if (texture) base = sample<N>(*texture, sampler, f.vec2(6));
+    F lit = F(kAmbient) + F(kDiffuse) * d;
+    F spec = F(kSpecular) * s;
+    f.color = {base.x * lit + spec, base.y * lit + spec, base.z * lit + spec, base.w * alpha};
+  }
+  // x^32 by five squarings (kShininess is 32).
+  template <int N>
+  static simd::Float<N> pow_shininess(simd::Float<N> x) {
+    static_assert(kShininess == 32.0f);
+    for (int k = 0; k < 5; ++k) x = x * x;
+    return x;
   }
 };
 
@@ -110,9 +122,10 @@ struct NormalsShader {
     v[0] = n.x, v[1] = n.y, v[2] = n.z;
     return in.clip(i);
   }
-  bool fragment(FragmentInput& f, glm::vec4& out) const {
-    out = glm::vec4(glm::normalize(f.vec3(0)) * 0.5f + 0.5f, 1.0f);
-    return true;
+  template <int N>
+  void shade(Fragments<N>& f) const {
+    simd::Vec3<N> n = simd::normalize(f.vec3(0)) * simd::Float<N>(0.5f) + simd::Float<N>(0.5f);
+    f.color = {n.x, n.y, n.z, simd::Float<N>(1.0f)};
   }
 };
 

@@ -4,8 +4,10 @@ reference (glref) side by side: the same flags, the images compared with imgdiff
 against the figures of SCENES.md, and the median frame time of each (the median of RUNS runs'
 medians) for each thread count: softrast --threads N beside llvmpipe with LP_NUM_THREADS=N.
 
-usage: compare_scenes.py [--scenes DIR] [--build DIR] [--out DIR] [--runs N] [--threads 1,2]
-                         [--only NAME[,NAME...]]
+usage: compare_scenes.py [--scenes DIR] [--models DIR] [--build DIR] [--out DIR] [--runs N]
+                         [--threads 1,2] [--only NAME[,NAME...]] [--all]
+By default it runs the rows of the speed issue's table (each with its target ratio); --all adds
+the other SCENES.md cases (flat shading, textured spheres).
 Build first with: cmake --preset release -DSOFTRAST_BUILD_REFERENCE=ON && cmake --build --preset
 release. Scenes: python3 ../shared/bench/gen_scenes.py DIR (the default DIR is /tmp/scenes).
 """
@@ -23,14 +25,28 @@ CAMERAS = {
                 "--cull back --frames 6",
     "quad_grid": "--eye 0,6,6 --target 0,0,-1 --up 0,1,0 --fov 50 --near 0.5 --far 100 "
                  "--cull back --frames 40",
+    # A real textured model (../shared/models), as the speed issue measures it.
+    "diablo3_pose": "--eye 0,0,3 --target 0,0,0 --up 0,1,0 --fov 45 --near 0.1 --far 100 "
+                    "--cull back --frames 40",
 }
-# (scene, shader, textured) in the order of SCENES.md.
+# Where each scene's files are: the generated scenes, or the shared models.
+MODEL_FILES = {"diablo3_pose": ("diablo3_pose/diablo3_pose.obj",
+                                "diablo3_pose/diablo3_pose_diffuse.tga")}
+# The speed issue's table: (scene, shader, textured) -> target llvmpipe/softrast ratio.
+TARGETS = {
+    ("spheres_1m", "gouraud", False): 4, ("spheres_1m", "phong", False): 4,
+    ("overdraw", "gouraud", False): 6, ("overdraw", "texture", True): 6,
+    ("overdraw", "phong", True): 10, ("quad_grid", "texture", True): 3,
+    ("quad_grid", "phong", True): 3, ("diablo3_pose", "phong", True): 4,
+}
+# (scene, shader, textured) in the order of SCENES.md, then the real model.
 CASES = [
     ("spheres_1m", "flat", False), ("spheres_1m", "gouraud", False),
     ("spheres_1m", "phong", False), ("spheres_1m", "texture", True),
     ("overdraw", "flat", False), ("overdraw", "gouraud", False),
     ("overdraw", "texture", True), ("overdraw", "phong", True),
     ("quad_grid", "texture", True), ("quad_grid", "phong", True),
+    ("diablo3_pose", "phong", True),
 ]
 # samples_passed that SCENES.md states.
 EXPECTED_SAMPLES = {"overdraw": 106166512, "quad_grid": 2073600}
@@ -54,6 +70,8 @@ def main():
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--threads", default="1,2")
     parser.add_argument("--only", default="")
+    parser.add_argument("--models", default=os.path.join(os.path.dirname(root), "shared", "models"))
+    parser.add_argument("--all", action="store_true")
     args = parser.parse_args()
     softrast = os.path.join(args.build, "softrast")
     glref = os.path.join(args.build, "tools", "reference", "glref")
@@ -66,20 +84,30 @@ def main():
         name = "%s_%s" % (scene, shader)
         if only and scene not in only and name not in only:
             continue
-        flags = ["%s/%s.obj" % (args.scenes, scene), "--size", "1920x1080"]
+        target = TARGETS.get((scene, shader, textured))
+        if target is None and not args.all:
+            continue
+        if scene in MODEL_FILES:
+            model, texture = (os.path.join(args.models, f) for f in MODEL_FILES[scene])
+        else:
+            model = "%s/%s.obj" % (args.scenes, scene)
+            texture = "%s/checker.png" % args.scenes
+        flags = [model, "--size", "1920x1080"]
         flags += CAMERAS[scene].split() + ["--shader", shader, "-q"]
         if textured:
-            flags += ["--texture", "%s/checker.png" % args.scenes]
+            flags += ["--texture", texture]
         soft_png = os.path.join(args.out, name + "_softrast.png")
         gl_png = os.path.join(args.out, name + "_llvmpipe.png")
         env = dict(os.environ)
         soft_ms, gl_ms, samples = {t: [] for t in threads}, {t: [] for t in threads}, None
+        peak_mib = 0.0
         for run in range(args.runs):
             for t in threads:
                 first = run == 0 and t == threads[0]
                 out = ["-o", soft_png] if first else []
                 line = run_json([softrast] + flags + ["--threads", t] + out, env)
                 soft_ms[t].append(line["median_ms"])
+                peak_mib = max(peak_mib, line.get("peak_rss_mib", 0.0))
                 out = ["-o", gl_png] if first else []
                 line = run_json([glref] + flags + out, dict(env, LP_NUM_THREADS=t))
                 gl_ms[t].append(line["median_ms"])
@@ -90,23 +118,28 @@ def main():
                "softrast_ms": {t: statistics.median(v) for t, v in soft_ms.items()},
                "llvmpipe_ms": {t: statistics.median(v) for t, v in gl_ms.items()},
                "samples_passed": samples, "expected_samples": EXPECTED_SAMPLES.get(scene),
+               "target": target, "softrast_peak_rss_mib": peak_mib,
                "diff": diff, "softrast_runs": soft_ms, "llvmpipe_runs": gl_ms}
         rows.append(row)
         print(json.dumps(row), flush=True)
     print()
     head = "| scene | shader | " + " | ".join(
-        "softrast ms (%s thr) | llvmpipe ms (%s thr)" % (t, t) for t in threads) + \
-        " | samples_passed (SCENES.md) | differing px | max diff | 3x3 mismatches | " \
-        "coverage diffs |"
+        "softrast ms (%s thr) | llvmpipe ms (%s thr) | llvmpipe/softrast (%s thr)" % (t, t, t)
+        for t in threads) + \
+        " | target | softrast peak MiB | samples_passed (SCENES.md) | differing px | max diff | " \
+        "3x3 mismatches | coverage diffs |"
     print(head)
     print("|" + "---|" * (head.count("|") - 1))
     for r in rows:
         d = r["diff"]
         expected = r["expected_samples"]
-        print("| %s | %s | %s | %d%s | %.4f %% | %d | %d | %d |" % (
+        print("| %s | %s | %s | %s | %.0f | %d%s | %.4f %% | %d | %d | %d |" % (
             r["scene"], r["shader"],
-            " | ".join("%.1f | %.1f" % (r["softrast_ms"][t], r["llvmpipe_ms"][t])
-                       for t in threads), r["samples_passed"],
+            " | ".join("%.1f | %.1f | %.2f" % (r["softrast_ms"][t], r["llvmpipe_ms"][t],
+                                                r["llvmpipe_ms"][t] / r["softrast_ms"][t])
+                       for t in threads),
+            (">= %d" % r["target"]) if r["target"] else "-", r["softrast_peak_rss_mib"],
+            r["samples_passed"],
             " (%d)" % expected if expected else "", 100 * d["differing_fraction"],
             d["max_channel_diff"], d["mismatches_3x3"], d["coverage_diffs"]))
 

@@ -1,0 +1,278 @@
+// softrast/detail/shade_simd.hpp: the fragment stage for shaders written against the wide types
+// of softrast/simd.hpp: a whole 4x4 block at a time (16 lanes, four 2x2 quads), interpolation,
+// depth test, the shader, colour packing and blending all vectorised. Compiled once per SIMD
+// level inside the caller's translation unit, chosen at the draw by simd_level().
+// Internal: included through softrast/shader.hpp.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+
+#include "softrast/detail/interpolants.hpp"
+#include "softrast/framebuffer.hpp"
+#include "softrast/render_state.hpp"
+#include "softrast/simd.hpp"
+#include "softrast/simd_level.hpp"
+
+namespace softrast {
+
+// What a wide fragment shader sees of one 4x4 block, and what it writes. Lane i is the pixel
+// (x0 + i % 4, y0 + i / 4).
+template <int N>
+struct Fragments {
+  using F = simd::Float<N>;
+  F x, y;                    // window coordinates of the samples (pixel centres)
+  F depth;                   // window depth in [0, 1]; a shader with kWritesDepth may set it
+  simd::Int<N> live;         // lanes still to be written: covered and not discarded
+  bool front_facing = true;  // the primitive's facing
+  const F* varyings = nullptr;  // the shader's kVaryings values, perspective-correct
+  simd::Vec4<N> color;       // the output, set by the shader
+
+  F varying(int i) const { return varyings[i]; }
+  simd::Vec2<N> vec2(int i) const { return {varyings[i], varyings[i + 1]}; }
+  simd::Vec3<N> vec3(int i) const { return {varyings[i], varyings[i + 1], varyings[i + 2]}; }
+  simd::Vec4<N> vec4(int i) const {
+    return {varyings[i], varyings[i + 1], varyings[i + 2], varyings[i + 3]};
+  }
+  // Change of a value to the next pixel right (ddx) or down (ddy), the same for the four pixels of
+  // each 2x2 quad (coarse derivatives, as D3D's ddx_coarse).
+  F ddx(const F& v) const { return quad_difference(v, 1); }
+  F ddy(const F& v) const { return quad_difference(v, 4); }
+  // Drops lanes (mask lanes -1) from the output; only for shaders declaring kDiscards = true.
+  void discard(const simd::Int<N>& lanes) { live = live & ~lanes; }
+
+ private:
+  // v at the quad's pixel `step` lanes after its top-left one, minus v at the top-left one.
+  static F quad_difference(const F& v, int step) {
+    float in[simd::kLanes], out[simd::kLanes];
+    v.store(in);
+    for (int i = 0; i < simd::kLanes; ++i) {
+      int top_left = i & ~(1 | 4);
+      out[i] = in[top_left + step] - in[top_left];
+    }
+    return F::load(out);
+  }
+};
+
+namespace detail {
+
+template <class S>
+concept WideShader = requires(const S& s, Fragments<4>& f4, Fragments<8>& f8,
+                              Fragments<16>& f16) {
+  s.template shade<4>(f4);
+  s.template shade<8>(f8);
+  s.template shade<16>(f16);
+};
+
+template <class S>
+concept DeclaresDiscards = requires {
+  requires S::kDiscards;
+};
+
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Float<N> eval_plane(const Plane& p, const simd::Float<N>& dx,
+                                               const simd::Float<N>& dy) {
+  // The scalar eval_plane's operation order, so that both give the same bits.
+  return simd::Float<N>(p.a0) + simd::Float<N>(p.dadx) * dx + simd::Float<N>(p.dady) * dy;
+}
+
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Int<N> depth_passes(DepthFunc f, const simd::Float<N>& z,
+                                               const simd::Float<N>& stored) {
+  switch (f) {
+    case DepthFunc::kNever:
+      return simd::Int<N>(0);
+    case DepthFunc::kLess:
+      return z < stored;
+    case DepthFunc::kEqual:
+      return z == stored;
+    case DepthFunc::kLessEqual:
+      return z <= stored;
+    case DepthFunc::kGreater:
+      return z > stored;
+    case DepthFunc::kNotEqual:
+      return z != stored;
+    case DepthFunc::kGreaterEqual:
+      return z >= stored;
+    case DepthFunc::kAlways:
+      return simd::Int<N>(-1);
+  }
+  return simd::Int<N>(0);
+}
+
+// pack_rgba8 for 16 lanes: clamp to [0, 1] (NaN to 0), x * 255 + 0.5 truncated, R in the low byte.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Int<N> pack_rgba8(const simd::Vec4<N>& c) {
+  using F = simd::Float<N>;
+  auto channel = [](const F& v) {
+    F clamped = simd::min(simd::max(v, F(0.0f)), F(1.0f));
+    return simd::to_int(clamped * F(255.0f) + F(0.5f));
+  };
+  return channel(c.x) | channel(c.y) << 8 | channel(c.z) << 16 | channel(c.w) << 24;
+}
+
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> unpack_rgba8(const simd::Int<N>& p) {
+  using F = simd::Float<N>;
+  const F k(1.0f / 255.0f);
+  simd::Int<N> byte(0xff);
+  return {simd::to_float(p & byte) * k, simd::to_float((p >> 8) & byte) * k,
+          simd::to_float((p >> 16) & byte) * k, simd::to_float(p >> 24) * k};
+}
+
+// blend_pixel for 16 lanes, the same formulas in the same order.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Int<N> blend(BlendMode mode, simd::Vec4<N> src,
+                                        const simd::Int<N>& dst_packed) {
+  using F = simd::Float<N>;
+  if (mode == BlendMode::kOpaque) return pack_rgba8(src);
+  const F zero(0.0f), one(1.0f);
+  src = {simd::clamp(src.x, zero, one), simd::clamp(src.y, zero, one),
+         simd::clamp(src.z, zero, one), simd::clamp(src.w, zero, one)};
+  simd::Vec4<N> dst = unpack_rgba8(dst_packed);
+  if (mode == BlendMode::kAdditive) {
+    return pack_rgba8(simd::Vec4<N>{src.x + dst.x, src.y + dst.y, src.z + dst.z, src.w + dst.w});
+  }
+  F inv = one - src.w;
+  simd::Vec4<N> out{src.x * src.w + dst.x * inv, src.y * src.w + dst.y * inv,
+                    src.z * src.w + dst.z * inv, src.w + dst.w * inv};
+  return pack_rgba8(out);
+}
+
+[[noreturn]] inline void undeclared_discard() {
+  std::fprintf(stderr,
+               "softrast: a shader discarded pixels without declaring kDiscards = true; the "
+               "deferred path cannot honour that\n");
+  std::abort();
+}
+
+// Shades the covered pixels (`mask`) of the 4x4 block at (x, y) with shader S on N-lane vectors.
+// kCommon compiles the state most draws use (depth less with writes, opaque) with its branches
+// resolved; `target.resolved` means visibility is already decided (see ShadeTarget).
+template <class S, int N, bool kCommon>
+SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& target,
+                                           const Interpolants& in, int x, int y, uint32_t mask) {
+  using F = simd::Float<N>;
+  using I = simd::Int<N>;
+  constexpr int kN = S::kVaryings > 0 ? S::kVaryings : 1;
+  constexpr bool kLateDepth = WritesDepth<S>;
+  Framebuffer& fb = *target.framebuffer;
+  const RenderState& st = *target.state;
+  const bool resolved = target.resolved;
+  const bool depth_test = !resolved && (kCommon || st.depth_test);
+  const DepthFunc depth_func = kCommon ? DepthFunc::kLess : st.depth_func;
+  const bool depth_write = kCommon || st.depth_write;
+  const BlendMode blend_mode = (kCommon || resolved) ? BlendMode::kOpaque : st.blend;
+
+  Fragments<N> f;
+  f.x = simd::to_float(I(x) + simd::lane_column<N>()) + F(0.5f);
+  f.y = simd::to_float(I(y) + simd::lane_row<N>()) + F(0.5f);
+  F dx = f.x - F(in.x_ref), dy = f.y - F(in.y_ref);
+  F z = simd::clamp(eval_plane<N>(in.z, dx, dy), F(0.0f), F(1.0f));
+  f.live = simd::lanes_of<N>(mask);
+
+  float* depth_at = &fb.depth_row(y)[x];
+  const size_t stride = size_t(fb.width());
+  F stored;
+  if (depth_test) {
+    stored = simd::load_block<F>(depth_at, stride);
+    if (!kLateDepth) {  // early depth test: the shader cannot change depth
+      f.live = f.live & depth_passes<N>(depth_func, z, stored);
+      if (!simd::any(f.live)) return;
+    }
+  }
+
+  // Helper pixels outside the primitive extrapolate; keep their 1/w positive and finite.
+  F inv_w = eval_plane<N>(in.inv_w, dx, dy);
+  inv_w = simd::select(inv_w < F(1.0e-30f), F(1.0e-30f), inv_w);
+  F w = F(1.0f) / inv_w;
+  F var[kN];
+  for (int i = 0; i < S::kVaryings; ++i) var[i] = eval_plane<N>(in.var[i], dx, dy) * w;
+  f.varyings = var;
+  f.depth = z;
+  f.front_facing = in.front_facing;
+  f.color = {F(0.0f), F(0.0f), F(0.0f), F(1.0f)};
+  const I covered = f.live;
+  shader.template shade<N>(f);
+  if constexpr (!DeclaresDiscards<S>) {
+    if (resolved && simd::bits(f.live) != simd::bits(covered)) undeclared_discard();
+  }
+
+  if (kLateDepth) {
+    z = simd::clamp(f.depth, F(0.0f), F(1.0f));
+    z = simd::select(z >= F(0.0f), z, F(0.0f));  // NaN
+    if (depth_test) f.live = f.live & depth_passes<N>(depth_func, z, stored);
+  }
+  if (!simd::any(f.live)) return;
+  if (depth_test && depth_write) {
+    F out = simd::select(f.live, z, stored);
+    simd::store_block(depth_at, stride, out);
+  }
+  uint32_t* color_at = &fb.color_row(y)[x];
+  I old = simd::load_block<I>(color_at, stride);
+  I packed = blend<N>(blend_mode, f.color, old);
+  I out = simd::select(f.live, packed, old);
+  simd::store_block(color_at, stride, out);
+}
+
+template <class S, int N>
+SOFTRAST_SIMD_INLINE void shade_block_level(const void* shader, const ShadeTarget& target,
+                                            const Interpolants& interp, int x, int y,
+                                            uint32_t mask) {
+  const S& s = *static_cast<const S*>(shader);
+  const RenderState& st = *target.state;
+  bool common = !WritesDepth<S> && st.depth_test && st.depth_func == DepthFunc::kLess &&
+                st.depth_write && st.blend == BlendMode::kOpaque;
+  if (common || target.resolved) {
+    shade_block_wide<S, N, true>(s, target, interp, x, y, mask);
+  } else {
+    shade_block_wide<S, N, false>(s, target, interp, x, y, mask);
+  }
+}
+
+// One entry point per SIMD level. `flatten` inlines the shader and everything it calls, so the
+// whole block is compiled for the level's instruction set.
+template <class S>
+[[gnu::flatten]] void shade_block_sse2(const void* shader, const ShadeTarget& target,
+                                       const Interpolants& interp, int x, int y, uint32_t mask) {
+  shade_block_level<S, 4>(shader, target, interp, x, y, mask);
+}
+template <class S>
+[[gnu::target("sse4.2"), gnu::flatten]] void shade_block_sse4(const void* shader,
+                                                              const ShadeTarget& target,
+                                                              const Interpolants& interp, int x,
+                                                              int y, uint32_t mask) {
+  shade_block_level<S, 4>(shader, target, interp, x, y, mask);
+}
+template <class S>
+[[gnu::target("avx2"), gnu::flatten]] void shade_block_avx2(const void* shader,
+                                                            const ShadeTarget& target,
+                                                            const Interpolants& interp, int x,
+                                                            int y, uint32_t mask) {
+  shade_block_level<S, 8>(shader, target, interp, x, y, mask);
+}
+template <class S>
+[[gnu::target("avx512f,avx512bw,avx512dq,avx512vl"), gnu::flatten]] void shade_block_avx512(
+    const void* shader, const ShadeTarget& target, const Interpolants& interp, int x, int y,
+    uint32_t mask) {
+  shade_block_level<S, 16>(shader, target, interp, x, y, mask);
+}
+
+template <class S>
+ShadeBlockFn wide_shade_block(SimdLevel level) {
+  switch (level) {
+    case SimdLevel::kAvx512:
+      return &shade_block_avx512<S>;
+    case SimdLevel::kAvx2:
+      return &shade_block_avx2<S>;
+    case SimdLevel::kSse4:
+      return &shade_block_sse4<S>;
+    case SimdLevel::kSse2:
+      break;
+  }
+  return &shade_block_sse2<S>;
+}
+
+}  // namespace detail
+}  // namespace softrast

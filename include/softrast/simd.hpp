@@ -1,0 +1,516 @@
+// softrast/simd.hpp: the wide types fragment shaders are written with. A value of Float<N> holds
+// one float per pixel of a 4x4 block (16 lanes, lane 4 * row + column), stored as 16 / N native
+// vectors of N lanes: N = 4 for SSE, 8 for AVX2, 16 for AVX-512. Shaders are templates on N and
+// read like scalar code; the fragment stage compiles them once per instruction set (each inside
+// a function with that set's target attribute, everything inlined) and picks one at run time.
+//
+// Why this shape: GCC's vector extensions at a native width lower to good code for any target
+// the enclosing function is compiled for, so one source serves every level, including shaders in
+// the user's own translation unit; the few operations the extensions lack (sqrt, gathers, mask
+// extraction) go through small helpers with a target attribute that take their vectors by
+// reference, so no wide vector crosses a call boundary between code built for different targets.
+#pragma once
+
+#include <immintrin.h>
+
+#include <cstdint>
+#include <cstring>
+
+namespace softrast::simd {
+
+#define SOFTRAST_SIMD_INLINE [[gnu::always_inline]] inline
+
+// Pixels of a 4x4 block: the unit the fragment stage shades.
+inline constexpr int kLanes = 16;
+
+// (Spelled out per width: GCC drops vector_size on an alias whose size depends on N.)
+template <int N>
+struct Native;
+template <>
+struct Native<4> {
+  typedef float F __attribute__((vector_size(16)));
+  typedef int32_t I __attribute__((vector_size(16)));
+  typedef uint32_t U __attribute__((vector_size(16)));
+};
+template <>
+struct Native<8> {
+  typedef float F __attribute__((vector_size(32)));
+  typedef int32_t I __attribute__((vector_size(32)));
+  typedef uint32_t U __attribute__((vector_size(32)));
+};
+template <>
+struct Native<16> {
+  typedef float F __attribute__((vector_size(64)));
+  typedef int32_t I __attribute__((vector_size(64)));
+  typedef uint32_t U __attribute__((vector_size(64)));
+};
+
+template <int N>
+struct Int;
+
+// AVX-512 comparisons and selects go through intrinsics: GCC 12 splits (or fails to compile)
+// some 512-bit vector conditions written with the extensions, since AVX-512 keeps them in mask
+// registers. Each helper has the AVX-512 target and takes its vectors by reference; the
+// fragment stage's entry point inlines them (flatten).
+namespace isa {
+using F16 = float __attribute__((vector_size(64)));
+using I16 = int32_t __attribute__((vector_size(64)));
+#define SOFTRAST_AVX512 [[gnu::target("avx512f,avx512bw,avx512dq,avx512vl")]] inline
+SOFTRAST_AVX512 void cmp(int predicate, const F16& a, const F16& b, I16& r);
+SOFTRAST_AVX512 void cmp(int predicate, const I16& a, const I16& b, I16& r);
+SOFTRAST_AVX512 void blend(const I16& mask, const F16& a, const F16& b, F16& r);
+SOFTRAST_AVX512 void blend(const I16& mask, const I16& a, const I16& b, I16& r);
+}  // namespace isa
+
+template <int N>
+struct Float {
+  static constexpr int kParts = kLanes / N;
+  using V = typename Native<N>::F;
+  using IV = typename Native<N>::I;
+  V p[kParts];
+
+  Float() = default;
+  // Broadcast; implicit so that 2.0f * x reads naturally. (Written as a shuffle of lane 0:
+  // GCC 12 builds `V{} + s` lane by lane once it has been inlined into a wider target.)
+  SOFTRAST_SIMD_INLINE Float(float s) {
+    V t = {};
+    t[0] = s;
+    for (int k = 0; k < kParts; ++k) p[k] = __builtin_shuffle(t, typename Native<N>::I{});
+  }
+  SOFTRAST_SIMD_INLINE static Float load(const float* lanes) {
+    Float r;
+    std::memcpy(r.p, lanes, sizeof r.p);
+    return r;
+  }
+  SOFTRAST_SIMD_INLINE void store(float* lanes) const { std::memcpy(lanes, p, sizeof p); }
+  SOFTRAST_SIMD_INLINE float lane(int i) const { return p[i / N][i % N]; }
+  SOFTRAST_SIMD_INLINE void set_lane(int i, float v) { p[i / N][i % N] = v; }
+
+#define SOFTRAST_SIMD_FLOAT_OP(op)                                             \
+  SOFTRAST_SIMD_INLINE friend Float operator op(const Float& a, const Float& b) { \
+    Float r;                                                                   \
+    for (int k = 0; k < kParts; ++k) r.p[k] = a.p[k] op b.p[k];                \
+    return r;                                                                  \
+  }                                                                            \
+  SOFTRAST_SIMD_INLINE Float& operator op##=(const Float & b) { return *this = *this op b; }
+  SOFTRAST_SIMD_FLOAT_OP(+)
+  SOFTRAST_SIMD_FLOAT_OP(-)
+  SOFTRAST_SIMD_FLOAT_OP(*)
+  SOFTRAST_SIMD_FLOAT_OP(/)
+#undef SOFTRAST_SIMD_FLOAT_OP
+  SOFTRAST_SIMD_INLINE friend Float operator-(const Float& a) {
+    Float r;
+    for (int k = 0; k < kParts; ++k) r.p[k] = -a.p[k];
+    return r;
+  }
+#define SOFTRAST_SIMD_FLOAT_CMP(op, predicate)                                     \
+  SOFTRAST_SIMD_INLINE friend Int<N> operator op(const Float& a, const Float& b) { \
+    Int<N> r;                                                                      \
+    for (int k = 0; k < kParts; ++k) {                                             \
+      if constexpr (N == 16) {                                                     \
+        isa::cmp(predicate, a.p[k], b.p[k], r.p[k]);                               \
+      } else {                                                                     \
+        r.p[k] = a.p[k] op b.p[k] ? ~IV{} : IV{};                                  \
+      }                                                                            \
+    }                                                                              \
+    return r;                                                                      \
+  }
+  SOFTRAST_SIMD_FLOAT_CMP(<, _CMP_LT_OQ)
+  SOFTRAST_SIMD_FLOAT_CMP(<=, _CMP_LE_OQ)
+  SOFTRAST_SIMD_FLOAT_CMP(>, _CMP_GT_OQ)
+  SOFTRAST_SIMD_FLOAT_CMP(>=, _CMP_GE_OQ)
+  SOFTRAST_SIMD_FLOAT_CMP(==, _CMP_EQ_OQ)
+  SOFTRAST_SIMD_FLOAT_CMP(!=, _CMP_NEQ_UQ)
+#undef SOFTRAST_SIMD_FLOAT_CMP
+};
+
+// 32-bit integers, and lane masks: a comparison gives -1 (all bits) where true, 0 where false;
+// consumers of masks (select, bits, any) read only the sign bit.
+template <int N>
+struct Int {
+  static constexpr int kParts = kLanes / N;
+  using V = typename Native<N>::I;
+  V p[kParts];
+
+  Int() = default;
+  SOFTRAST_SIMD_INLINE Int(int32_t s) {  // broadcast, as Float's
+    V t = {};
+    t[0] = s;
+    for (int k = 0; k < kParts; ++k) p[k] = __builtin_shuffle(t, V{});
+  }
+  SOFTRAST_SIMD_INLINE static Int load(const int32_t* lanes) {
+    Int r;
+    std::memcpy(r.p, lanes, sizeof r.p);
+    return r;
+  }
+  SOFTRAST_SIMD_INLINE void store(int32_t* lanes) const { std::memcpy(lanes, p, sizeof p); }
+  SOFTRAST_SIMD_INLINE int32_t lane(int i) const { return p[i / N][i % N]; }
+
+#define SOFTRAST_SIMD_INT_OP(op)                                              \
+  SOFTRAST_SIMD_INLINE friend Int operator op(const Int& a, const Int& b) { \
+    Int r;                                                                  \
+    for (int k = 0; k < kParts; ++k) r.p[k] = a.p[k] op b.p[k];             \
+    return r;                                                               \
+  }
+  SOFTRAST_SIMD_INT_OP(+)
+  SOFTRAST_SIMD_INT_OP(-)
+  SOFTRAST_SIMD_INT_OP(*)
+  SOFTRAST_SIMD_INT_OP(&)
+  SOFTRAST_SIMD_INT_OP(|)
+  SOFTRAST_SIMD_INT_OP(^)
+#undef SOFTRAST_SIMD_INT_OP
+  // Comparisons written as selects: GCC 12 keeps a vector condition whole, where it may split
+  // a bare integer comparison into lanes.
+#define SOFTRAST_SIMD_INT_CMP(op, predicate)                                   \
+  SOFTRAST_SIMD_INLINE friend Int operator op(const Int& a, const Int& b) {    \
+    Int r;                                                                     \
+    for (int k = 0; k < kParts; ++k) {                                         \
+      if constexpr (N == 16) {                                                 \
+        isa::cmp(predicate, a.p[k], b.p[k], r.p[k]);                           \
+      } else {                                                                 \
+        r.p[k] = a.p[k] op b.p[k] ? ~V{} : V{};                                \
+      }                                                                        \
+    }                                                                          \
+    return r;                                                                  \
+  }
+  SOFTRAST_SIMD_INT_CMP(<, _MM_CMPINT_LT)
+  SOFTRAST_SIMD_INT_CMP(>, _MM_CMPINT_NLE)
+  SOFTRAST_SIMD_INT_CMP(==, _MM_CMPINT_EQ)
+  SOFTRAST_SIMD_INT_CMP(!=, _MM_CMPINT_NE)
+#undef SOFTRAST_SIMD_INT_CMP
+  SOFTRAST_SIMD_INLINE friend Int operator~(const Int& a) {
+    Int r;
+    for (int k = 0; k < kParts; ++k) r.p[k] = ~a.p[k];
+    return r;
+  }
+  SOFTRAST_SIMD_INLINE friend Int operator<<(const Int& a, int s) {
+    Int r;
+    for (int k = 0; k < kParts; ++k) r.p[k] = a.p[k] << s;
+    return r;
+  }
+  // Logical shift (zeros in from the left), as packed colours need.
+  SOFTRAST_SIMD_INLINE friend Int operator>>(const Int& a, int s) {
+    using U = typename Native<N>::U;
+    Int r;
+    for (int k = 0; k < kParts; ++k) r.p[k] = V(U(a.p[k]) >> s);
+    return r;
+  }
+};
+
+// mask ? a : b, lane by lane (mask lanes are -1 or 0).
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> select(const Int<N>& mask, const Float<N>& a, const Float<N>& b) {
+  Float<N> r;
+  // `< 0` (the sign bit) rather than `!= 0`: GCC 12 splits the latter into lanes for AVX-512.
+  for (int k = 0; k < Float<N>::kParts; ++k) {
+    if constexpr (N == 16) {
+      isa::blend(mask.p[k], a.p[k], b.p[k], r.p[k]);
+    } else {
+      r.p[k] = mask.p[k] < 0 ? a.p[k] : b.p[k];
+    }
+  }
+  return r;
+}
+template <int N>
+SOFTRAST_SIMD_INLINE Int<N> select(const Int<N>& mask, const Int<N>& a, const Int<N>& b) {
+  Int<N> r;
+  for (int k = 0; k < Int<N>::kParts; ++k) {
+    if constexpr (N == 16) {
+      isa::blend(mask.p[k], a.p[k], b.p[k], r.p[k]);
+    } else {
+      r.p[k] = mask.p[k] < 0 ? a.p[k] : b.p[k];
+    }
+  }
+  return r;
+}
+
+// min/max with the SSE semantics (and std::min/std::max's): the second operand when either is
+// NaN, so max(NaN, 0) is 0.
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> min(const Float<N>& a, const Float<N>& b) {
+  return select(a < b, a, b);
+}
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> max(const Float<N>& a, const Float<N>& b) {
+  return select(a > b, a, b);
+}
+// std::clamp's definition: v < lo ? lo : (hi < v ? hi : v) (NaN stays NaN).
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> clamp(const Float<N>& v, const Float<N>& lo, const Float<N>& hi) {
+  return select(v < lo, lo, select(hi < v, hi, v));
+}
+
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> to_float(const Int<N>& a) {
+  Float<N> r;
+  for (int k = 0; k < Float<N>::kParts; ++k) {
+    r.p[k] = __builtin_convertvector(a.p[k], typename Native<N>::F);
+  }
+  return r;
+}
+// Truncates towards zero. Precondition: |a| < 2^31 (NaN and larger values are unspecified).
+template <int N>
+SOFTRAST_SIMD_INLINE Int<N> to_int(const Float<N>& a) {
+  Int<N> r;
+  for (int k = 0; k < Int<N>::kParts; ++k) {
+    r.p[k] = __builtin_convertvector(a.p[k], typename Native<N>::I);
+  }
+  return r;
+}
+template <int N>
+SOFTRAST_SIMD_INLINE Int<N> bit_cast_int(const Float<N>& a) {
+  Int<N> r;
+  std::memcpy(r.p, a.p, sizeof r.p);
+  return r;
+}
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> bit_cast_float(const Int<N>& a) {
+  Float<N> r;
+  std::memcpy(r.p, a.p, sizeof r.p);
+  return r;
+}
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> abs(const Float<N>& a) {
+  return bit_cast_float(bit_cast_int(a) & Int<N>(0x7fffffff));
+}
+
+// ---- Operations the vector extensions lack: one helper per instruction set. ----
+namespace isa {
+
+// The comparison predicate must be a constant after inlining (it always is: an operator's).
+SOFTRAST_AVX512 void cmp(int predicate, const F16& a, const F16& b, I16& r) {
+  __mmask16 m = 0;
+  switch (predicate) {
+    case _CMP_LT_OQ: m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_LT_OQ); break;
+    case _CMP_LE_OQ: m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_LE_OQ); break;
+    case _CMP_GT_OQ: m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_GT_OQ); break;
+    case _CMP_GE_OQ: m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_GE_OQ); break;
+    case _CMP_EQ_OQ: m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_EQ_OQ); break;
+    default: m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_NEQ_UQ); break;
+  }
+  r = I16(_mm512_movm_epi32(m));
+}
+SOFTRAST_AVX512 void cmp(int predicate, const I16& a, const I16& b, I16& r) {
+  __mmask16 m = 0;
+  switch (predicate) {
+    case _MM_CMPINT_LT: m = _mm512_cmplt_epi32_mask(__m512i(a), __m512i(b)); break;
+    case _MM_CMPINT_NLE: m = _mm512_cmpgt_epi32_mask(__m512i(a), __m512i(b)); break;
+    case _MM_CMPINT_EQ: m = _mm512_cmpeq_epi32_mask(__m512i(a), __m512i(b)); break;
+    default: m = _mm512_cmpneq_epi32_mask(__m512i(a), __m512i(b)); break;
+  }
+  r = I16(_mm512_movm_epi32(m));
+}
+SOFTRAST_AVX512 void blend(const I16& mask, const F16& a, const F16& b, F16& r) {
+  r = F16(_mm512_mask_blend_ps(_mm512_movepi32_mask(__m512i(mask)), __m512(b), __m512(a)));
+}
+SOFTRAST_AVX512 void blend(const I16& mask, const I16& a, const I16& b, I16& r) {
+  r = I16(_mm512_mask_blend_epi32(_mm512_movepi32_mask(__m512i(mask)), __m512i(b), __m512i(a)));
+}
+
+inline void sqrt(const Native<4>::F& a, Native<4>::F& r) {
+  r = Native<4>::F(_mm_sqrt_ps(__m128(a)));
+}
+[[gnu::target("avx")]] inline void sqrt(const Native<8>::F& a, Native<8>::F& r) {
+  r = Native<8>::F(_mm256_sqrt_ps(__m256(a)));
+}
+[[gnu::target("avx512f")]] inline void sqrt(const Native<16>::F& a, Native<16>::F& r) {
+  r = Native<16>::F(_mm512_maskz_sqrt_ps(__mmask16(0xffff), __m512(a)));  // maskz: no undefined source
+}
+
+inline int sign_bits(const Native<4>::I& a) {
+  return _mm_movemask_ps(__m128(a));
+}
+[[gnu::target("avx")]] inline int sign_bits(const Native<8>::I& a) {
+  return _mm256_movemask_ps(__m256(a));
+}
+[[gnu::target("avx512f,avx512dq")]] inline int sign_bits(const Native<16>::I& a) {
+  return int(_mm512_movepi32_mask(__m512i(a)));
+}
+
+// r[i] = base[index[i]] for 32-bit elements.
+inline void gather(const int32_t* base, const Native<4>::I& index, Native<4>::I& r) {
+  for (int i = 0; i < 4; ++i) {
+    int32_t v;
+    std::memcpy(&v, base + index[i], sizeof v);  // the base may be a byte array
+    r[i] = v;
+  }
+}
+[[gnu::target("avx2")]] inline void gather(const int32_t* base, const Native<8>::I& index,
+                                            Native<8>::I& r) {
+  r = Native<8>::I(_mm256_mask_i32gather_epi32(_mm256_setzero_si256(), base, __m256i(index),
+                                                _mm256_set1_epi32(-1), 4));
+}
+[[gnu::target("avx512f")]] inline void gather(const int32_t* base, const Native<16>::I& index,
+                                               Native<16>::I& r) {
+  r = Native<16>::I(
+      _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(0xffff), __m512i(index), base, 4));
+}
+
+}  // namespace isa
+
+// IEEE square root, exact in every lane (as std::sqrt).
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> sqrt(const Float<N>& a) {
+  Float<N> r;
+  for (int k = 0; k < Float<N>::kParts; ++k) isa::sqrt(a.p[k], r.p[k]);
+  return r;
+}
+
+// Bit i set where lane i of the mask is set (its sign bit).
+template <int N>
+SOFTRAST_SIMD_INLINE uint32_t bits(const Int<N>& mask) {
+  uint32_t r = 0;
+  for (int k = 0; k < Int<N>::kParts; ++k) r |= uint32_t(isa::sign_bits(mask.p[k])) << (k * N);
+  return r;
+}
+template <int N>
+SOFTRAST_SIMD_INLINE bool any(const Int<N>& mask) {
+  return bits(mask) != 0;
+}
+
+// Lane i = base[index[i]]; every index must be valid.
+template <int N>
+SOFTRAST_SIMD_INLINE Int<N> gather(const int32_t* base, const Int<N>& index) {
+  Int<N> r;
+  for (int k = 0; k < Int<N>::kParts; ++k) isa::gather(base, index.p[k], r.p[k]);
+  return r;
+}
+
+// Lane constants, loaded as vectors (GCC builds a vector lane by lane otherwise).
+alignas(64) inline constexpr uint32_t kLaneToSign[kLanes] = {
+    1u << 31, 1u << 30, 1u << 29, 1u << 28, 1u << 27, 1u << 26, 1u << 25, 1u << 24,
+    1u << 23, 1u << 22, 1u << 21, 1u << 20, 1u << 19, 1u << 18, 1u << 17, 1u << 16};
+alignas(64) inline constexpr int32_t kLaneColumn[kLanes] = {0, 1, 2, 3, 0, 1, 2, 3,
+                                                             0, 1, 2, 3, 0, 1, 2, 3};
+alignas(64) inline constexpr int32_t kLaneRow[kLanes] = {0, 0, 0, 0, 1, 1, 1, 1,
+                                                          2, 2, 2, 2, 3, 3, 3, 3};
+
+// The lane mask of a 16-bit block mask. Masks are read by their sign bit everywhere (select,
+// bits, and/or), so lane i only needs bit i of `mask` moved to bit 31: a multiplication by
+// 2^(31 - i), with no comparison (GCC 12 splits some AVX-512 comparisons into lanes).
+template <int N>
+SOFTRAST_SIMD_INLINE Int<N> lanes_of(uint32_t mask) {
+  using U = typename Native<N>::U;
+  Int<N> m = Int<N>(int32_t(mask)), out;
+  for (int k = 0; k < Int<N>::kParts; ++k) {
+    U scale;
+    std::memcpy(&scale, kLaneToSign + k * N, sizeof scale);
+    out.p[k] = typename Native<N>::I(U(m.p[k]) * scale);
+  }
+  return out;
+}
+// Column (0..3) and row (0..3) of each lane within the block.
+template <int N>
+SOFTRAST_SIMD_INLINE Int<N> lane_column() {
+  return Int<N>::load(kLaneColumn);
+}
+template <int N>
+SOFTRAST_SIMD_INLINE Int<N> lane_row() {
+  return Int<N>::load(kLaneRow);
+}
+
+// The 4x4 block of a row-major array of 32-bit values (float or uint32_t) whose top-left element
+// is `at`, `stride` elements per row, into the 16 lanes of V (Float<N> or Int<N>) and back. Rows
+// are loaded as 4-lane vectors and joined in registers (a wide load of four narrow stores would
+// stall store forwarding).
+template <class V, class T>
+SOFTRAST_SIMD_INLINE V load_block(const T* at, size_t stride) {
+  static_assert(sizeof(T) == 4);
+  using Row = typename Native<4>::F;
+  Row r[4];
+  for (int k = 0; k < 4; ++k) std::memcpy(&r[k], at + stride * size_t(k), 16);
+  V out;
+  constexpr int kParts = V::kParts;
+  if constexpr (kParts == 4) {
+    for (int k = 0; k < 4; ++k) std::memcpy(&out.p[k], &r[k], 16);
+  } else if constexpr (kParts == 2) {
+    auto a = __builtin_shufflevector(r[0], r[1], 0, 1, 2, 3, 4, 5, 6, 7);
+    auto b = __builtin_shufflevector(r[2], r[3], 0, 1, 2, 3, 4, 5, 6, 7);
+    std::memcpy(&out.p[0], &a, 32);
+    std::memcpy(&out.p[1], &b, 32);
+  } else {
+    auto a = __builtin_shufflevector(r[0], r[1], 0, 1, 2, 3, 4, 5, 6, 7);
+    auto b = __builtin_shufflevector(r[2], r[3], 0, 1, 2, 3, 4, 5, 6, 7);
+    auto c = __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+    std::memcpy(&out.p[0], &c, 64);
+  }
+  return out;
+}
+template <class V, class T>
+SOFTRAST_SIMD_INLINE void store_block(T* at, size_t stride, const V& v) {
+  static_assert(sizeof(T) == 4);
+  using Row = typename Native<4>::F;
+  Row r[4];
+  constexpr int kParts = V::kParts;
+  if constexpr (kParts == 4) {
+    for (int k = 0; k < 4; ++k) std::memcpy(&r[k], &v.p[k], 16);
+  } else if constexpr (kParts == 2) {
+    typename Native<8>::F a, b;
+    std::memcpy(&a, &v.p[0], 32);
+    std::memcpy(&b, &v.p[1], 32);
+    r[0] = __builtin_shufflevector(a, a, 0, 1, 2, 3);
+    r[1] = __builtin_shufflevector(a, a, 4, 5, 6, 7);
+    r[2] = __builtin_shufflevector(b, b, 0, 1, 2, 3);
+    r[3] = __builtin_shufflevector(b, b, 4, 5, 6, 7);
+  } else {
+    typename Native<16>::F a;
+    std::memcpy(&a, &v.p[0], 64);
+    r[0] = __builtin_shufflevector(a, a, 0, 1, 2, 3);
+    r[1] = __builtin_shufflevector(a, a, 4, 5, 6, 7);
+    r[2] = __builtin_shufflevector(a, a, 8, 9, 10, 11);
+    r[3] = __builtin_shufflevector(a, a, 12, 13, 14, 15);
+  }
+  for (int k = 0; k < 4; ++k) std::memcpy(at + stride * size_t(k), &r[k], 16);
+}
+
+// ---- Small vectors of wide values, with glm's names. ----
+
+template <int N>
+struct Vec2 {
+  Float<N> x, y;
+};
+template <int N>
+struct Vec3 {
+  Float<N> x, y, z;
+  SOFTRAST_SIMD_INLINE friend Vec3 operator+(const Vec3& a, const Vec3& b) {
+    return {a.x + b.x, a.y + b.y, a.z + b.z};
+  }
+  SOFTRAST_SIMD_INLINE friend Vec3 operator-(const Vec3& a, const Vec3& b) {
+    return {a.x - b.x, a.y - b.y, a.z - b.z};
+  }
+  SOFTRAST_SIMD_INLINE friend Vec3 operator*(const Vec3& a, const Vec3& b) {
+    return {a.x * b.x, a.y * b.y, a.z * b.z};
+  }
+  SOFTRAST_SIMD_INLINE friend Vec3 operator*(const Vec3& a, const Float<N>& s) {
+    return {a.x * s, a.y * s, a.z * s};
+  }
+  SOFTRAST_SIMD_INLINE friend Vec3 operator*(const Float<N>& s, const Vec3& a) {
+    return {s * a.x, s * a.y, s * a.z};
+  }
+  SOFTRAST_SIMD_INLINE friend Vec3 operator+(const Vec3& a, const Float<N>& s) {
+    return {a.x + s, a.y + s, a.z + s};
+  }
+};
+template <int N>
+struct Vec4 {
+  Float<N> x, y, z, w;
+};
+
+// A wide vector from a glm-like constant (anything with x, y, z).
+template <int N, class V3>
+SOFTRAST_SIMD_INLINE Vec3<N> splat3(const V3& v) {
+  return {Float<N>(v.x), Float<N>(v.y), Float<N>(v.z)};
+}
+
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> dot(const Vec3<N>& a, const Vec3<N>& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+// v / |v| as glm::normalize computes it: v * (1 / sqrt(dot(v, v))).
+template <int N>
+SOFTRAST_SIMD_INLINE Vec3<N> normalize(const Vec3<N>& v) {
+  Float<N> inv = Float<N>(1.0f) / sqrt(dot(v, v));
+  return v * inv;
+}
+
+}  // namespace softrast::simd
