@@ -4,13 +4,16 @@
 // block, huge ones, and the image's cut last row and column of tiles.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <random>
 #include <utility>
 
 #include "pipeline/tile_kernels.hpp"
 #include "raster/raster.hpp"
+#include "softrast/shader.hpp"
 
 namespace softrast {
 namespace {
@@ -115,6 +118,45 @@ TEST(TileKernel, CoverageEqualsTheEdgeEquationRasterizer) {
         for (auto& w : v) w.x = (w.x & ~255) + 128, w.y = (w.y & ~255) + 128;
       }
       ASSERT_TRUE(agrees(v, width, height)) << "size " << size << " triangle " << i;
+    }
+  }
+}
+
+// The resolve kernels' depth is the fragment stage's (shade_block.hpp) to the bit, including
+// the clamp of values outside [0, 1], NaN and large gradients, and the test is LESS or LEQUAL.
+TEST(TileKernel, ResolveComputesTheFragmentStagesDepth) {
+  std::mt19937 rng(99);
+  std::uniform_real_distribution<float> value(-2.0f, 3.0f), gradient(-0.3f, 0.3f),
+      ref(-100.0f, 400.0f);
+  for (int level = 0; level <= int(cpu_simd_level()); ++level) {
+    detail::ResolveBlockFn resolve = detail::tile_kernels(SimdLevel(level)).resolve_block;
+    for (int i = 0; i < 2000; ++i) {
+      detail::DepthPlaneRef p{ref(rng), ref(rng), {value(rng), gradient(rng), gradient(rng)}};
+      if (i % 10 == 0) p.z.a0 = std::numeric_limits<float>::quiet_NaN();
+      if (i % 10 == 1) p.z.dadx = 1e30f;
+      if (i % 10 == 2) p.z = {0.5f, 0.0f, 0.0f};  // ties with the stored 0.5 below
+      int x = 4 * int(rng() % 4000), y = 4 * int(rng() % 4000);
+      uint32_t mask = rng() & 0xffffu;
+      bool less_equal = i % 2 == 0;
+      alignas(64) float depth[16];
+      alignas(64) int32_t ids[16];
+      for (int l = 0; l < 16; ++l) depth[l] = l % 3 == 0 ? 0.5f : value(rng), ids[l] = -1;
+      float expected_depth[16];
+      int32_t expected_ids[16];
+      for (int l = 0; l < 16; ++l) {
+        float dx = float(x + (l & 3)) + 0.5f - p.x_ref, dy = float(y + (l >> 2)) + 0.5f - p.y_ref;
+        float z = std::clamp(detail::eval_plane(p.z, dx, dy), 0.0f, 1.0f);
+        bool pass = (mask >> l & 1) &&
+                    detail::depth_passes(less_equal ? DepthFunc::kLessEqual : DepthFunc::kLess, z,
+                                         depth[l]);
+        expected_depth[l] = pass ? z : depth[l];
+        expected_ids[l] = pass ? 7 : -1;
+      }
+      resolve(p, x, y, mask, 7, less_equal, depth, ids);
+      ASSERT_EQ(std::memcmp(depth, expected_depth, sizeof(depth)), 0)
+          << simd_level_name(SimdLevel(level)) << " case " << i;
+      ASSERT_EQ(std::memcmp(ids, expected_ids, sizeof(ids)), 0)
+          << simd_level_name(SimdLevel(level)) << " case " << i;
     }
   }
 }

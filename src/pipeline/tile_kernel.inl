@@ -64,32 +64,101 @@ template <class V, class T>
 }
 
 // ---------------------------------------------------------------------------------------------
-// The depth resolve of one block (tile_visibility.hpp): the fragment stage's depth, exactly
-// (dx = float(px) + 0.5 - x_ref, z = clamp((a0 + dadx dx) + dady dy, 0, 1) with std::clamp's
-// handling of NaN and -0, no contraction), tested against the tile's depth; where it passes,
-// depth and winner id are written.
-template <bool kLessEqual>
-[[gnu::always_inline]] inline void resolve_lanes(const DepthPlaneRef& p, int x, int y,
-                                                 uint32_t mask, int32_t id, float* depth,
-                                                 int32_t* ids) {
+// The depth resolve of one block (tile_visibility.hpp): the fragment stage's depth, exactly, tested
+// against the tile's depth; where it passes, depth and winner id are written.
+//
+// The fragment stage computes dx = (float(px) + 0.5f) - x_ref and z = clamp((a0 + dadx * dx) +
+// dady * dy, 0, 1) with std::clamp (NaN stays NaN, -0 stays -0), without contraction. Here
+// float(px) + 0.5f is formed as (float(x) + 0.5f) + column: both are exact (integers and
+// half-integers below 2^23, the image is at most 16384 wide), so only the subtraction of x_ref
+// rounds, as there. std::clamp(z, 0, 1) is `z < 0 ? 0 : (1 < z ? 1 : z)`, which is exactly
+// max(0, min(1, z)) with x86's operand order (MINPS returns its second operand unless the first
+// is smaller, so NaN and -0 come through as z).
+
+// A triangle's depth plane over an area of at most a tile, as its two halves: the fragment
+// stage's z = (a0 + dadx * dx) + dady * dy is the sum of a term per block column and a term per
+// block row, each computed once from the same operands (so each block's z is the same float sum,
+// for one addition).
+struct DepthTerms {
+  static constexpr int kMax = kTileSize / kBlockSize;
+  F x_term[kMax][kGroups];  // a0 + dadx * dx, block column i (pixels x0 + 4 i ..)
+  F y_term[kMax][kGroups];  // dady * dy, block row j
+  int x0, y0;
+  int32_t id;
+};
+
+// Terms for the blocks of [x0, x1) x [y0, y1); x0 and y0 multiples of 4, at most a tile.
+[[gnu::always_inline]] inline void depth_terms(const Interpolants& in, int32_t id, int x0, int x1,
+                                               int y0, int y1, DepthTerms& d) {
+  d.x0 = x0;
+  d.y0 = y0;
+  d.id = id;
+  F x_ref = F{} + in.x_ref, y_ref = F{} + in.y_ref;
   for (int g = 0; g < kGroups; ++g) {
-    I lane = pixel_index(g);
-    F dx = (__builtin_convertvector((lane & 3) + x, F) + 0.5f) - p.x_ref;
-    F dy = (__builtin_convertvector((lane >> 2) + y, F) + 0.5f) - p.y_ref;
-    F z = (p.z.a0 + p.z.dadx * dx) + p.z.dady * dy;
-    F zero = F{} + 0.0f, one = F{} + 1.0f;
-    z = (one < z) ? one : z;
-    z = (z < zero) ? zero : z;
-    F stored;
-    I winner;
-    std::memcpy(&stored, depth + g * kLanes, sizeof(F));
-    std::memcpy(&winner, ids + g * kLanes, sizeof(I));
-    I covered = ((int32_t(mask) >> lane) & 1) != 0;
-    I pass = (kLessEqual ? (z <= stored) : (z < stored)) & covered;
-    stored = pass ? z : stored;
-    winner = pass ? (I{} + id) : winner;
-    std::memcpy(depth + g * kLanes, &stored, sizeof(F));
-    std::memcpy(ids + g * kLanes, &winner, sizeof(I));
+    I p = pixel_index(g);
+    F column = __builtin_convertvector(p & 3, F), row = __builtin_convertvector(p >> 2, F);
+    for (int i = 0; x0 + kBlockSize * i < x1; ++i) {
+      F dx = ((F{} + (float(x0 + kBlockSize * i) + 0.5f)) + column) - x_ref;
+      d.x_term[i][g] = in.z.a0 + in.z.dadx * dx;
+    }
+    for (int j = 0; y0 + kBlockSize * j < y1; ++j) {
+      F dy = ((F{} + (float(y0 + kBlockSize * j) + 0.5f)) + row) - y_ref;
+      d.y_term[j][g] = in.z.dady * dy;
+    }
+  }
+}
+
+// min(1, z) and max(0, z) with the operand order of std::clamp (see above).
+[[gnu::always_inline]] inline F clamp01(F z) {
+#if SOFTRAST_LANES == 16
+  __m512 m = _mm512_min_ps(_mm512_set1_ps(1.0f), reinterpret_cast<__m512>(z));
+  return reinterpret_cast<F>(_mm512_max_ps(_mm512_setzero_ps(), m));
+#elif SOFTRAST_LANES == 8
+  __m256 m = _mm256_min_ps(_mm256_set1_ps(1.0f), reinterpret_cast<__m256>(z));
+  return reinterpret_cast<F>(_mm256_max_ps(_mm256_setzero_ps(), m));
+#else
+  __m128 m = _mm_min_ps(_mm_set1_ps(1.0f), reinterpret_cast<__m128>(z));
+  return reinterpret_cast<F>(_mm_max_ps(_mm_setzero_ps(), m));
+#endif
+}
+
+// Depth test of the lanes of `mask` (bits of the group's pixels) and the write of the winners.
+template <bool kLessEqual>
+[[gnu::always_inline]] inline void test_and_write(F z, uint32_t mask, int32_t id, float* depth,
+                                                  int32_t* ids) {
+#if SOFTRAST_LANES == 16
+  // AVX-512: the test runs under the coverage mask and the winners are masked stores.
+  __m512 stored = _mm512_loadu_ps(depth);
+  __mmask16 pass = _mm512_mask_cmp_ps_mask(__mmask16(mask), reinterpret_cast<__m512>(z), stored,
+                                           kLessEqual ? _CMP_LE_OQ : _CMP_LT_OQ);
+  _mm512_mask_storeu_ps(depth, pass, reinterpret_cast<__m512>(z));
+  _mm512_mask_storeu_epi32(ids, pass, _mm512_set1_epi32(id));
+#else
+  F stored;
+  I winner;
+  std::memcpy(&stored, depth, sizeof(F));
+  std::memcpy(&winner, ids, sizeof(I));
+  I bit = I{} + 1;
+  for (int l = 0; l < kLanes; ++l) bit[l] <<= l;
+  I covered = ((I{} + int32_t(mask)) & bit) != 0;
+  I pass = (kLessEqual ? (z <= stored) : (z < stored)) & covered;
+  stored = pass ? z : stored;
+  winner = pass ? (I{} + id) : winner;
+  std::memcpy(depth, &stored, sizeof(F));
+  std::memcpy(ids, &winner, sizeof(I));
+#endif
+}
+
+template <bool kLessEqual>
+[[gnu::always_inline]] inline void resolve_lanes(const DepthTerms& d, int x, int y, uint32_t mask,
+                                                 float* depth, int32_t* ids) {
+  const F* x_term = d.x_term[(x - d.x0) >> 2];
+  const F* y_term = d.y_term[(y - d.y0) >> 2];
+  for (int g = 0; g < kGroups; ++g) {
+    uint32_t group_mask = (mask >> (g * kLanes)) & ((1u << kLanes) - 1u);
+    if (kGroups > 1 && group_mask == 0) continue;
+    F z = clamp01(x_term[g] + y_term[g]);
+    test_and_write<kLessEqual>(z, group_mask, d.id, depth + g * kLanes, ids + g * kLanes);
   }
 }
 
@@ -105,19 +174,29 @@ enum class Mode { kImmediate, kLess, kLessEqual };
   return block_rect_mask(0, std::min(kBlockSize, r.x1 - x), 0, std::min(kBlockSize, r.y1 - y));
 }
 
+// Where a record's covered blocks go: the fragment stage, or the tile's depth resolve.
 template <Mode kMode>
-[[gnu::always_inline]] inline void emit(TileJob& job, const TriRecord& rec, int32_t id, int x,
-                                        int y, uint32_t bits) {
-  if constexpr (kMode == Mode::kImmediate) {
-    job.program->shade_block(job.program->shader, *job.target, rec.interp(), x, y, bits);
-  } else {
-    TileVisibility& v = *job.visibility;
-    int b = v.block(x, y);
-    const Interpolants& in = rec.interp();
-    DepthPlaneRef plane{in.x_ref, in.y_ref, in.z};
-    resolve_lanes<kMode == Mode::kLessEqual>(plane, x, y, bits, id, v.depth[b], v.id[b]);
+struct BlockTarget {
+  TileJob& job;
+  const TriRecord& rec;
+  DepthTerms depth;
+
+  BlockTarget(TileJob& j, const TriRecord& r, int32_t id, const PixelRect& area) : job(j), rec(r) {
+    if constexpr (kMode != Mode::kImmediate) {
+      depth_terms(r.interp(), id, area.x0 & ~(kBlockSize - 1), area.x1,
+                  area.y0 & ~(kBlockSize - 1), area.y1, depth);
+    }
   }
-}
+  [[gnu::always_inline]] void operator()(int x, int y, uint32_t bits) {
+    if constexpr (kMode == Mode::kImmediate) {
+      job.program->shade_block(job.program->shader, *job.target, rec.interp(), x, y, bits);
+    } else {
+      TileVisibility& v = *job.visibility;
+      int b = v.block(x, y);
+      resolve_lanes<kMode == Mode::kLessEqual>(depth, x, y, bits, v.depth[b], v.id[b]);
+    }
+  }
+};
 
 // Exact block classification against the three edges, as tile_raster.cpp's: E is linear, so its
 // extremes over the block's samples are at the corner samples picked by the signs of a and b.
@@ -160,6 +239,7 @@ template <Mode kMode, class V, class T>
                                                       int32_t id, const PixelRect& area,
                                                       const EdgeGrid& grid) {
   const TriangleCoverage& t = rec.coverage;
+  BlockTarget<kMode> emit(job, rec, id, area);
   EdgeOffsets<V> offsets;
   make_offsets<V, T>(t, offsets);
   int bx0 = area.x0 & ~(kBlockSize - 1), by0 = area.y0 & ~(kBlockSize - 1);
@@ -167,7 +247,7 @@ template <Mode kMode, class V, class T>
     int64_t e[3];
     grid.at(x, y, e);
     uint32_t bits = coverage_bits<V, T>(e, offsets) & region_bits(job.region, x, y);
-    if (bits != 0) emit<kMode>(job, rec, id, x, y, bits);
+    if (bits != 0) emit(x, y, bits);
   };
   // Small areas (at most 16x16 pixels of blocks, the usual triangle of a dense mesh): every
   // block's coverage directly, no classification.
@@ -197,7 +277,7 @@ template <Mode kMode, class V, class T>
             sub = classify(e, small);
           }
           if (sub == Test::kInside) {
-            emit<kMode>(job, rec, id, x, y, region_bits(job.region, x, y));
+            emit(x, y, region_bits(job.region, x, y));
           } else if (sub == Test::kPartial) {
             partial_block(x, y);
           }
@@ -257,9 +337,15 @@ void raster_deferred(TileJob& job, const std::byte* arena, const uint32_t* offse
 }
 void resolve_block(const DepthPlaneRef& plane, int x, int y, uint32_t mask, int32_t id,
                    bool less_equal, float* depth, int32_t* ids) {
+  Interpolants in;
+  in.x_ref = plane.x_ref;
+  in.y_ref = plane.y_ref;
+  in.z = plane.z;
+  DepthTerms d;
+  depth_terms(in, id, x, x + kBlockSize, y, y + kBlockSize, d);
   if (less_equal) {
-    resolve_lanes<true>(plane, x, y, mask, id, depth, ids);
+    resolve_lanes<true>(d, x, y, mask, depth, ids);
   } else {
-    resolve_lanes<false>(plane, x, y, mask, id, depth, ids);
+    resolve_lanes<false>(d, x, y, mask, depth, ids);
   }
 }

@@ -27,11 +27,16 @@ namespace avx2 {
 
 #pragma GCC push_options
 #pragma GCC target("avx512f,avx512bw,avx512dq,avx512vl")
+// GCC 12's _mm512_undefined_ps initialises a variable with itself and -Wmaybe-uninitialized
+// reports it inside every AVX-512 min/max (GCC bug 105593, fixed in GCC 13).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 namespace avx512 {
 #define SOFTRAST_LANES 16
 #include "pipeline/tile_kernel.inl"
 #undef SOFTRAST_LANES
 }  // namespace avx512
+#pragma GCC diagnostic pop
 #pragma GCC pop_options
 
 TileKernels tile_kernels(SimdLevel level) {
