@@ -47,7 +47,9 @@ struct PackedVertex {
   float z, inv_w;
 };
 
-struct Chunk {
+// Cache-line aligned: each chunk's arena and bins are written by one thread while neighbours are
+// written by others.
+struct alignas(64) Chunk {
   RecordArena records;
   std::vector<std::vector<uint32_t>> bins;  // per tile: offsets of its records in `records`
 };
