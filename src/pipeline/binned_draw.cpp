@@ -41,12 +41,6 @@ constexpr size_t kBatchTriangles = 32768;
 constexpr int kChunksPerThread = 4;
 constexpr size_t kVerticesPerJob = 8192;
 
-// A vertex in window space (valid when its code is 0): WindowVertex without the varyings pointer.
-struct PackedVertex {
-  int32_t x, y;
-  float z, inv_w;
-};
-
 // Cache-line aligned: each chunk's arena and bins are written by one thread while neighbours are
 // written by others.
 struct alignas(64) Chunk {
@@ -126,22 +120,16 @@ class BinnedDraw {
   }
 
  private:
-  // Phase 0: outcodes and window positions, once per vertex.
+  // Phase 0: outcodes and window positions, once per vertex, several at a time.
   void transform_vertices() {
     size_t n = geometry_.vertex_count();
     cache_.window.resize(n);
     cache_.codes.resize(n);
+    VertexBatch batch = geometry_.vertex_batch(cache_.codes.data(), cache_.window.data());
+    VertexKernelFn kernel = vertex_kernel(simd_level());
     size_t jobs = (n + kVerticesPerJob - 1) / kVerticesPerJob;
     parallel_for(jobs, threads_, [&](size_t job) {
-      size_t end = std::min(n, (job + 1) * kVerticesPerJob);
-      for (size_t i = job * kVerticesPerJob; i < end; ++i) {
-        uint32_t code = geometry_.vertex_code(uint32_t(i));
-        cache_.codes[i] = uint8_t(code);
-        if (code == 0) {
-          WindowVertex w = geometry_.window_vertex(uint32_t(i));
-          cache_.window[i] = {w.x, w.y, w.z, w.inv_w};
-        }
-      }
+      kernel(batch, job * kVerticesPerJob, std::min(n, (job + 1) * kVerticesPerJob));
     });
   }
 

@@ -9,6 +9,7 @@
 
 #include "geometry/clip.hpp"
 #include "geometry/viewport.hpp"
+#include "pipeline/vertex_kernels.hpp"
 #include "raster/setup.hpp"
 #include "softrast/render_state.hpp"
 
@@ -77,6 +78,20 @@ class GeometryStage {
   // Vertex i in window space, exactly as triangle() makes it; precondition: vertex_code(i) == 0.
   WindowVertex window_vertex(uint32_t i) const { return window(vertex(i)); }
   const float* varyings(uint32_t i) const { return vertex(i) + 4; }
+  // The same for many vertices at once (vertex_kernels.hpp), writing to `codes` and `window`.
+  VertexBatch vertex_batch(uint8_t* codes, PackedVertex* window) const {
+    VertexBatch b;
+    b.data = vertices_.data;
+    b.stride = vertices_.stride;
+    b.guard_x = volume_.guard_x;
+    b.guard_y = volume_.guard_y;
+    b.width = viewport_.width;
+    b.height = viewport_.height;
+    b.depth_bias = state_.depth_bias;
+    b.codes = codes;
+    b.window = window;
+    return b;
+  }
 
   // The window position of point i; false when it lies outside the clip volume.
   bool point(uint32_t i, WindowVertex& out) const {
