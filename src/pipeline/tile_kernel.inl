@@ -293,12 +293,21 @@ template <Mode kMode>
   PixelRect area = intersect(t.bounds, job.region);
   if (area.empty()) return;
   EdgeGrid grid;
-  grid.x0 = area.x0;
-  grid.y0 = area.y0;
+  grid.x0 = area.x0 & ~(kBlockSize - 1);
+  grid.y0 = area.y0 & ~(kBlockSize - 1);
   for (int k = 0; k < 3; ++k) {
-    grid.origin[k] = t.edge[k].at(sample_fx8(area.x0), sample_fx8(area.y0));
+    grid.origin[k] = t.edge[k].at(sample_fx8(grid.x0), sample_fx8(grid.y0));
     grid.step_x[k] = t.edge[k].a * kSubpixelOne;
     grid.step_y[k] = t.edge[k].b * kSubpixelOne;
+  }
+  if (rec.small && area.x1 - grid.x0 <= kBlockSize && area.y1 - grid.y0 <= kBlockSize) {
+    // Inside one block (the usual triangle of a dense mesh): that block's coverage, nothing else.
+    EdgeOffsets<I> offsets;
+    make_offsets<I, int32_t>(t, offsets);
+    uint32_t bits = coverage_bits<I, int32_t>(grid.origin, offsets) &
+                    region_bits(job.region, grid.x0, grid.y0);
+    if (bits != 0) BlockTarget<kMode>(job, rec, id, area)(grid.x0, grid.y0, bits);
+    return;
   }
   if (rec.small) {
     raster_record_with<kMode, I, int32_t>(job, rec, id, area, grid);

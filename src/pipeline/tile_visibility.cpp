@@ -2,6 +2,8 @@
 // resolve kernels are in tile_kernel.inl).
 #include "pipeline/tile_visibility.hpp"
 
+#include <emmintrin.h>
+
 #include <algorithm>
 #include <cstring>
 
@@ -64,6 +66,21 @@ void TileVisibility::reset() {
   }
 }
 
+namespace {
+
+// Bit l set where ids[l] == value, for the 16 ids of a block (SSE2, the x86-64 baseline).
+uint32_t lanes_equal(const int32_t* ids, int32_t value) {
+  __m128i v = _mm_set1_epi32(value);
+  uint32_t bits = 0;
+  for (int q = 0; q < 4; ++q) {
+    __m128i four = _mm_load_si128(reinterpret_cast<const __m128i*>(ids + 4 * q));
+    bits |= uint32_t(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(four, v)))) << (4 * q);
+  }
+  return bits;
+}
+
+}  // namespace
+
 void shade_winners(const TileVisibility& vis, const Interpolants* const* interps,
                    const FragmentProgram& program, const ShadeTarget& resolved_target) {
   constexpr int kPerRow = TileVisibility::kBlocksPerRow;
@@ -71,15 +88,13 @@ void shade_winners(const TileVisibility& vis, const Interpolants* const* interps
     for (uint64_t bits = vis.touched[word]; bits != 0; bits &= bits - 1) {
       int b = word * 64 + __builtin_ctzll(bits);
       const int32_t* ids = vis.id[b];
-      uint32_t left = 0;
-      for (int l = 0; l < 16; ++l) left |= uint32_t(ids[l] != TileVisibility::kNoWinner) << l;
+      uint32_t left = ~lanes_equal(ids, TileVisibility::kNoWinner) & 0xffffu;
       int x = vis.region.x0 + (b % kPerRow) * kBlockSize;
       int y = vis.region.y0 + (b / kPerRow) * kBlockSize;
       // One call per distinct winner of the block, with exactly the pixels it won.
       while (left != 0) {
         int32_t winner = ids[__builtin_ctz(left)];
-        uint32_t mask = 0;
-        for (int l = 0; l < 16; ++l) mask |= uint32_t(ids[l] == winner) << l;
+        uint32_t mask = lanes_equal(ids, winner);
         left &= ~mask;
         program.shade_block(program.shader, resolved_target, *interps[winner], x, y, mask);
       }
