@@ -230,6 +230,36 @@ TEST_F(CliTest, TextureShaderShowsTheTexture) {
   EXPECT_EQ(pixel(image, 26, 26)[1], 255);
 }
 
+TEST_F(CliTest, LightFlagSetsTheWorldSpaceLightDirection) {
+  // The quad faces +z: lit head-on it is brighter than lit from the side, and a light from
+  // behind leaves only the ambient term (albedo * 0.15).
+  CliRun front = run("quad.obj --size 32x32 --shader gouraud --light 0,0,1 -o front.png");
+  CliRun side = run("quad.obj --size 32x32 --shader gouraud --light 1,0,0.2 -o side.png");
+  CliRun back = run("quad.obj --size 32x32 --shader gouraud --light 0,0,-1 -o back.png");
+  ASSERT_EQ(front.exit_code, 0) << front.err;
+  ASSERT_EQ(side.exit_code, 0) << side.err;
+  ASSERT_EQ(back.exit_code, 0) << back.err;
+  int r_front = pixel(load("front.png", 32, 32), 16, 16)[0];
+  int r_side = pixel(load("side.png", 32, 32), 16, 16)[0];
+  int r_back = pixel(load("back.png", 32, 32), 16, 16)[0];
+  EXPECT_EQ(r_front, to_unorm8(0.9f * (0.15f + 0.85f)));
+  EXPECT_EQ(r_back, to_unorm8(0.9f * 0.15f));
+  EXPECT_GT(r_front, r_side);
+  EXPECT_GT(r_side, r_back);
+}
+
+TEST_F(CliTest, UnsupportedTextureFormatIsOneErrorLine) {
+  // A 16-bit PGM header with no data: the old texture decoder (stb_image) read past its buffer
+  // converting it and the program died of SIGSEGV.
+  write("deep.pgm", "P5\n1000 1000\n65535\n");
+  CliRun r = run("quad.obj --texture deep.pgm -o out.png");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err,
+            "softrast: error: deep.pgm: unsupported image format (PNG, TGA and JPG are "
+            "supported)\n");
+  EXPECT_EQ(files(), fixtures_and({"deep.pgm"}));
+}
+
 TEST_F(CliTest, HelpMentionsEveryFlag) {
   for (const char* args : {"--help", "render --help", "-h"}) {
     CliRun r = run(args);
@@ -240,6 +270,7 @@ TEST_F(CliTest, HelpMentionsEveryFlag) {
           "--near",    "--far",        "--shader", "--wireframe", "--texture", "--color",
           "--cull",    "--front-face", "--depth",  "--blend",     "--alpha",   "--raster",
           "--filter",  "--wrap",       "--frames", "--threads",   "--quiet",   "--help",
+          "--light",
           "--version", "-o",           "MODEL",    "flat",        "gouraud",   "phong",
           "normals",   "scanline",     "notequal", "mirror"}) {
       EXPECT_NE(r.out.find(flag), std::string::npos) << args << " does not mention " << flag;
@@ -310,6 +341,7 @@ const BadInput kBadInputs[] = {
     {"GarbageTexture", "quad.obj --texture garbage.png -o out.png"},
     {"MissingTexture", "quad.obj --texture missing.png -o out.png"},
     {"TextureIsAnObj", "--texture quad.obj -o out.png"},
+    {"TextureIsDevZero", "quad.obj --texture /dev/zero -o out.png"},
     {"ZeroSize", "--size 0x100 -o out.png"},
     {"ZeroHeight", "--size 100x0 -o out.png"},
     {"NegativeSize", "--size=-5x10 -o out.png"},
@@ -343,6 +375,8 @@ const BadInput kBadInputs[] = {
     {"UpAlongView", "quad.obj --up 0,0,1 -o out.png"},
     {"ColorTwoNumbers", "--color 1,2 -o out.png"},
     {"ColorOutOfRange", "--color 2,0,0 -o out.png"},
+    {"LightZero", "--light 0,0,0 -o out.png"},
+    {"LightTwoNumbers", "--light 1,2 -o out.png"},
     {"OrthoThreeNumbers", "--ortho 1,2,3 -o out.png"},
     {"OrthoEmptyBox", "--ortho 1,1,0,1 -o out.png"},
     {"AlphaOutOfRange", "--alpha 1.5 -o out.png"},

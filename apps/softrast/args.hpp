@@ -19,6 +19,7 @@ struct RawArgs {
   bool wireframe = false;
   std::optional<std::string> texture;
   std::optional<std::string> color;
+  std::optional<std::string> light;
   std::string cull = "back";
   std::string front_face = "ccw";
   std::string depth = "less";

@@ -125,6 +125,11 @@ void interpret_shading(const RawArgs& a, RenderOptions& options, FirstError& e) 
     e.fail_if(!in_unit_range(c.r) || !in_unit_range(c.g) || !in_unit_range(c.b),
               "--color: every channel must be in [0, 1], got '" + *a.color + "'");
   }
+  if (a.light) {
+    e.take(parse_vec3("--light", *a.light), options.light_direction);
+    e.fail_if(!(glm::length(options.light_direction) > 1.0e-6f),
+              "--light: the direction must not be zero, got '" + *a.light + "'");
+  }
   e.fail_if(!in_unit_range(a.alpha), "--alpha: must be in [0, 1]");
   options.alpha = a.alpha;
   e.take(lookup<Filter>("--filter", kFilters, a.filter), options.sampler.filter);

@@ -14,6 +14,16 @@ namespace softrast {
 // window coordinate inside the fixed-point range with a wide guard band (see raster/fixed_point).
 inline constexpr int kMaxImageSize = 16384;
 
+// Largest pixel count a decoded file may have: 64 Mi pixels, 256 MiB as RGBA8. It admits 8192x8192
+// and 16384x4096 while keeping one texture load (the Image, then the Texture's copy of it) near
+// 512 MiB. kMaxImageSize alone would allow 16384x16384, 1 GiB per copy, which a few hundred bytes
+// of compressed data can declare; images the library makes itself (framebuffers) are not capped.
+inline constexpr int64_t kMaxImagePixels = int64_t(1) << 26;
+
+// Largest file load_image reads (and buffer decode_image takes): 512 MiB, twice the largest RGBA8
+// image within kMaxImagePixels stored raw, so any sensible encoding of an accepted image fits.
+inline constexpr int64_t kMaxImageFileBytes = int64_t(512) << 20;
+
 // An 8-bit RGBA image, rows top to bottom, 4 bytes per pixel, no padding.
 struct Image {
   int width = 0;
@@ -28,11 +38,15 @@ struct Image {
   }
 };
 
-// Reads a PNG, TGA (bottom-up or top-down rows), JPG or BMP file into RGBA8, top row first.
-// Errors name the file: missing, unreadable, not an image, or larger than kMaxImageSize.
+// Reads a PNG, TGA (bottom-up or top-down rows) or JPG file into RGBA8, top row first. The format
+// is told by the file's contents, not its name; any other format is an error. Errors name the
+// file: missing, unreadable, larger than kMaxImageFileBytes, not one of the three formats,
+// truncated or corrupt (never a partly invented image), or wider or taller than kMaxImageSize or
+// with more than kMaxImagePixels pixels (refused from the header, before any pixel is allocated).
 Result<Image> load_image(const std::string& path);
 
-// Decodes an image held in memory (same formats as load_image); `name` is used in messages.
+// Decodes an image held in memory (same formats and limits as load_image); `name` is used in
+// messages.
 Result<Image> decode_image(const uint8_t* data, size_t size, const std::string& name);
 
 // Writes `image` as PNG or TGA, chosen by the extension of `path` (.png, .tga; case-insensitive).

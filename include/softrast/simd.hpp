@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 namespace softrast::simd {
 
@@ -31,18 +32,27 @@ struct Native<4> {
   typedef float F __attribute__((vector_size(16)));
   typedef int32_t I __attribute__((vector_size(16)));
   typedef uint32_t U __attribute__((vector_size(16)));
+  // For loads and stores at any 4-byte aligned address, through any type.
+  typedef float FU __attribute__((vector_size(16), aligned(4), may_alias));
+  typedef int32_t IU __attribute__((vector_size(16), aligned(4), may_alias));
 };
 template <>
 struct Native<8> {
   typedef float F __attribute__((vector_size(32)));
   typedef int32_t I __attribute__((vector_size(32)));
   typedef uint32_t U __attribute__((vector_size(32)));
+  // For loads and stores at any 4-byte aligned address, through any type.
+  typedef float FU __attribute__((vector_size(32), aligned(4), may_alias));
+  typedef int32_t IU __attribute__((vector_size(32), aligned(4), may_alias));
 };
 template <>
 struct Native<16> {
   typedef float F __attribute__((vector_size(64)));
   typedef int32_t I __attribute__((vector_size(64)));
   typedef uint32_t U __attribute__((vector_size(64)));
+  // For loads and stores at any 4-byte aligned address, through any type.
+  typedef float FU __attribute__((vector_size(64), aligned(4), may_alias));
+  typedef int32_t IU __attribute__((vector_size(64), aligned(4), may_alias));
 };
 
 template <int N>
@@ -77,12 +87,15 @@ struct Float {
     t[0] = s;
     for (int k = 0; k < kParts; ++k) p[k] = __builtin_shuffle(t, typename Native<N>::I{});
   }
+  // (Typed unaligned vector accesses: GCC 12 splits a memcpy of the parts into 16-byte moves.)
   SOFTRAST_SIMD_INLINE static Float load(const float* lanes) {
     Float r;
-    std::memcpy(r.p, lanes, sizeof r.p);
+    for (int k = 0; k < kParts; ++k) r.p[k] = *reinterpret_cast<const typename Native<N>::FU*>(lanes + k * N);
     return r;
   }
-  SOFTRAST_SIMD_INLINE void store(float* lanes) const { std::memcpy(lanes, p, sizeof p); }
+  SOFTRAST_SIMD_INLINE void store(float* lanes) const {
+    for (int k = 0; k < kParts; ++k) *reinterpret_cast<typename Native<N>::FU*>(lanes + k * N) = p[k];
+  }
   SOFTRAST_SIMD_INLINE float lane(int i) const { return p[i / N][i % N]; }
   SOFTRAST_SIMD_INLINE void set_lane(int i, float v) { p[i / N][i % N] = v; }
 
@@ -140,10 +153,12 @@ struct Int {
   }
   SOFTRAST_SIMD_INLINE static Int load(const int32_t* lanes) {
     Int r;
-    std::memcpy(r.p, lanes, sizeof r.p);
+    for (int k = 0; k < kParts; ++k) r.p[k] = *reinterpret_cast<const typename Native<N>::IU*>(lanes + k * N);
     return r;
   }
-  SOFTRAST_SIMD_INLINE void store(int32_t* lanes) const { std::memcpy(lanes, p, sizeof p); }
+  SOFTRAST_SIMD_INLINE void store(int32_t* lanes) const {
+    for (int k = 0; k < kParts; ++k) *reinterpret_cast<typename Native<N>::IU*>(lanes + k * N) = p[k];
+  }
   SOFTRAST_SIMD_INLINE int32_t lane(int i) const { return p[i / N][i % N]; }
 
 #define SOFTRAST_SIMD_INT_OP(op)                                              \
@@ -260,13 +275,13 @@ SOFTRAST_SIMD_INLINE Int<N> to_int(const Float<N>& a) {
 template <int N>
 SOFTRAST_SIMD_INLINE Int<N> bit_cast_int(const Float<N>& a) {
   Int<N> r;
-  std::memcpy(r.p, a.p, sizeof r.p);
+  for (int k = 0; k < Int<N>::kParts; ++k) r.p[k] = typename Native<N>::I(a.p[k]);
   return r;
 }
 template <int N>
 SOFTRAST_SIMD_INLINE Float<N> bit_cast_float(const Int<N>& a) {
   Float<N> r;
-  std::memcpy(r.p, a.p, sizeof r.p);
+  for (int k = 0; k < Float<N>::kParts; ++k) r.p[k] = typename Native<N>::F(a.p[k]);
   return r;
 }
 template <int N>
@@ -393,8 +408,7 @@ SOFTRAST_SIMD_INLINE Int<N> lanes_of(uint32_t mask) {
   using U = typename Native<N>::U;
   Int<N> m = Int<N>(int32_t(mask)), out;
   for (int k = 0; k < Int<N>::kParts; ++k) {
-    U scale;
-    std::memcpy(&scale, kLaneToSign + k * N, sizeof scale);
+    U scale = U(*reinterpret_cast<const typename Native<N>::IU*>(kLaneToSign + k * N));
     out.p[k] = typename Native<N>::I(U(m.p[k]) * scale);
   }
   return out;
@@ -417,22 +431,23 @@ template <class V, class T>
 SOFTRAST_SIMD_INLINE V load_block(const T* at, size_t stride) {
   static_assert(sizeof(T) == 4);
   using Row = typename Native<4>::F;
+  using Part = std::remove_reference_t<decltype(V{}.p[0])>;
   Row r[4];
-  for (int k = 0; k < 4; ++k) std::memcpy(&r[k], at + stride * size_t(k), 16);
+  for (int k = 0; k < 4; ++k) {
+    r[k] = Row(*reinterpret_cast<const typename Native<4>::FU*>(at + stride * size_t(k)));
+  }
   V out;
   constexpr int kParts = V::kParts;
   if constexpr (kParts == 4) {
-    for (int k = 0; k < 4; ++k) std::memcpy(&out.p[k], &r[k], 16);
+    for (int k = 0; k < 4; ++k) out.p[k] = Part(r[k]);
   } else if constexpr (kParts == 2) {
-    auto a = __builtin_shufflevector(r[0], r[1], 0, 1, 2, 3, 4, 5, 6, 7);
-    auto b = __builtin_shufflevector(r[2], r[3], 0, 1, 2, 3, 4, 5, 6, 7);
-    std::memcpy(&out.p[0], &a, 32);
-    std::memcpy(&out.p[1], &b, 32);
+    out.p[0] = Part(__builtin_shufflevector(r[0], r[1], 0, 1, 2, 3, 4, 5, 6, 7));
+    out.p[1] = Part(__builtin_shufflevector(r[2], r[3], 0, 1, 2, 3, 4, 5, 6, 7));
   } else {
     auto a = __builtin_shufflevector(r[0], r[1], 0, 1, 2, 3, 4, 5, 6, 7);
     auto b = __builtin_shufflevector(r[2], r[3], 0, 1, 2, 3, 4, 5, 6, 7);
-    auto c = __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    std::memcpy(&out.p[0], &c, 64);
+    out.p[0] = Part(
+        __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
   }
   return out;
 }
@@ -443,24 +458,23 @@ SOFTRAST_SIMD_INLINE void store_block(T* at, size_t stride, const V& v) {
   Row r[4];
   constexpr int kParts = V::kParts;
   if constexpr (kParts == 4) {
-    for (int k = 0; k < 4; ++k) std::memcpy(&r[k], &v.p[k], 16);
+    for (int k = 0; k < 4; ++k) r[k] = Row(v.p[k]);
   } else if constexpr (kParts == 2) {
-    typename Native<8>::F a, b;
-    std::memcpy(&a, &v.p[0], 32);
-    std::memcpy(&b, &v.p[1], 32);
+    auto a = typename Native<8>::F(v.p[0]), b = typename Native<8>::F(v.p[1]);
     r[0] = __builtin_shufflevector(a, a, 0, 1, 2, 3);
     r[1] = __builtin_shufflevector(a, a, 4, 5, 6, 7);
     r[2] = __builtin_shufflevector(b, b, 0, 1, 2, 3);
     r[3] = __builtin_shufflevector(b, b, 4, 5, 6, 7);
   } else {
-    typename Native<16>::F a;
-    std::memcpy(&a, &v.p[0], 64);
+    auto a = typename Native<16>::F(v.p[0]);
     r[0] = __builtin_shufflevector(a, a, 0, 1, 2, 3);
     r[1] = __builtin_shufflevector(a, a, 4, 5, 6, 7);
     r[2] = __builtin_shufflevector(a, a, 8, 9, 10, 11);
     r[3] = __builtin_shufflevector(a, a, 12, 13, 14, 15);
   }
-  for (int k = 0; k < 4; ++k) std::memcpy(at + stride * size_t(k), &r[k], 16);
+  for (int k = 0; k < 4; ++k) {
+    *reinterpret_cast<typename Native<4>::FU*>(at + stride * size_t(k)) = r[k];
+  }
 }
 
 // ---- Small vectors of wide values, with glm's names. ----

@@ -1,13 +1,14 @@
-// io/image_io.cpp: image files in and out through stb_image and stb_image_write.
-// Decoding always asks stb for RGBA8; saving goes through a temporary file and a rename.
+// io/image_io.cpp: image files in and out. Reading picks PNG, JPEG or TGA by the file's contents
+// and hands it to that format's decoder (io/*_decode.cpp); writing goes through stb_image_write
+// and a temporary file that is renamed over the target.
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <cerrno>
-#include <climits>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -15,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include <stb_image.h>
 #include <stb_image_write.h>
 
+#include "io/image_decode.hpp"
 #include "softrast/image.hpp"
 
 namespace softrast {
@@ -44,16 +45,57 @@ struct FileCloser {
 };
 using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
 
-// Reads the whole file; fails on open or read errors (including "is a directory").
+// Bytes read before the format is decided: enough for every signature and the TGA header, so a
+// file that is not an image (or an endless device such as /dev/zero) is refused at once.
+constexpr size_t kSniffBytes = 64;
+constexpr size_t kReadBlock = size_t(1) << 16;
+
+std::string mib_text(int64_t bytes) {
+  return std::to_string(bytes >> 20) + " MiB";
+}
+
+Status too_large(const std::string& path) {
+  return fail(path,
+              "file is larger than " + mib_text(kMaxImageFileBytes) + ", the limit for images");
+}
+
+// Appends up to `limit` bytes more from f; false on a read error (errno says why).
+bool read_some(std::FILE* f, std::vector<uint8_t>& bytes, size_t limit) {
+  uint8_t buffer[kReadBlock];
+  while (limit > 0) {
+    size_t n = std::fread(buffer, 1, std::min(limit, sizeof buffer), f);
+    if (n == 0) break;
+    bytes.insert(bytes.end(), buffer, buffer + n);
+    limit -= n;
+  }
+  return !std::ferror(f);
+}
+
+Status unsupported(const std::string& name) {
+  return fail(name, "unsupported image format (PNG, TGA and JPG are supported)");
+}
+
+// Reads the whole file, at most kMaxImageFileBytes of it: a regular file's size is checked before
+// reading, anything else (pipes, devices) is cut off one byte past the limit. The first bytes
+// must look like a supported image before the rest is read. Fails on open or read errors
+// (including "is a directory").
 Status read_file(const std::string& path, std::vector<uint8_t>& bytes) {
   FilePtr f(std::fopen(path.c_str(), "rb"));
   if (!f) return fail(path, "cannot open: " + errno_text());
-  uint8_t buffer[1 << 16];
-  size_t n;
-  while ((n = std::fread(buffer, 1, sizeof buffer, f.get())) > 0) {
-    bytes.insert(bytes.end(), buffer, buffer + n);
+  struct stat info {};
+  if (fstat(fileno(f.get()), &info) == 0 && S_ISREG(info.st_mode)) {
+    if (info.st_size > kMaxImageFileBytes) return too_large(path);
+    bytes.reserve(size_t(info.st_size));
   }
-  if (std::ferror(f.get())) return fail(path, "cannot read: " + errno_text());
+  if (!read_some(f.get(), bytes, kSniffBytes)) return fail(path, "cannot read: " + errno_text());
+  if (!bytes.empty() && !detail::is_png(bytes.data(), bytes.size()) &&
+      !detail::is_jpeg(bytes.data(), bytes.size()) && !detail::is_tga(bytes.data(), bytes.size())) {
+    return unsupported(path);
+  }
+  if (!read_some(f.get(), bytes, size_t(kMaxImageFileBytes) + 1 - bytes.size())) {
+    return fail(path, "cannot read: " + errno_text());
+  }
+  if (bytes.size() > size_t(kMaxImageFileBytes)) return too_large(path);
   return {};
 }
 
@@ -110,35 +152,36 @@ bool write_new_file(const std::string& path, const std::vector<uint8_t>& bytes,
   return ok;
 }
 
-// stb keeps its last failure per thread; it is a short phrase such as "bad png sig".
-std::string stb_reason() {
-  const char* reason = stbi_failure_reason();
-  return reason ? reason : "unknown error";
+}  // namespace
+
+namespace detail {
+
+Status image_error(const std::string& name, const std::string& reason) {
+  return fail(name, reason);
 }
 
-}  // namespace
+Status check_image_size(const std::string& name, int64_t width, int64_t height) {
+  std::string size = std::to_string(width) + "x" + std::to_string(height);
+  if (width < 1 || height < 1 || width > kMaxImageSize || height > kMaxImageSize) {
+    return fail(name, "image size " + size + " is outside 1.." + std::to_string(kMaxImageSize));
+  }
+  if (width * height > kMaxImagePixels) {
+    return fail(name, "image size " + size + " has more than " + std::to_string(kMaxImagePixels) +
+                          " pixels, the limit for images");
+  }
+  return {};
+}
+
+}  // namespace detail
 
 Result<Image> decode_image(const uint8_t* data, size_t size, const std::string& name) {
   if (size == 0) return fail(name, "empty file");
-  if (size > size_t(INT_MAX)) return fail(name, "file too large to decode");
-  // stbi_info reads only the header, so absurd sizes are refused before any allocation.
-  int width = 0, height = 0, channels = 0;
-  if (!stbi_info_from_memory(data, int(size), &width, &height, &channels)) {
-    return fail(name, "not a readable image (" + stb_reason() + ")");
-  }
-  if (!valid_size(width, height)) {
-    return fail(name, "image size " + size_text(width, height) + " is outside 1.." +
-                          std::to_string(kMaxImageSize));
-  }
-  uint8_t* pixels = stbi_load_from_memory(data, int(size), &width, &height, &channels, 4);
-  if (!pixels) {
-    return fail(name, "cannot decode image (" + stb_reason() + ")");
-  }
-  std::unique_ptr<uint8_t, void (*)(void*)> owner(pixels, stbi_image_free);
-  if (!valid_size(width, height)) return fail(name, "image size changed while decoding");
-  Image image(width, height);
-  std::copy(pixels, pixels + image.rgba.size(), image.rgba.begin());
-  return image;
+  if (size > size_t(kMaxImageFileBytes)) return too_large(name);
+  // Signatures first; TGA has none, so it is last and only on a strictly valid header.
+  if (detail::is_png(data, size)) return detail::decode_png(data, size, name);
+  if (detail::is_jpeg(data, size)) return detail::decode_jpeg(data, size, name);
+  if (detail::is_tga(data, size)) return detail::decode_tga(data, size, name);
+  return unsupported(name);
 }
 
 Result<Image> load_image(const std::string& path) {

@@ -93,7 +93,7 @@ def main():
             model = "%s/%s.obj" % (args.scenes, scene)
             texture = "%s/checker.png" % args.scenes
         flags = [model, "--size", "1920x1080"]
-        flags += CAMERAS[scene].split() + ["--shader", shader, "-q"]
+        flags += CAMERAS[scene].split() + ["--shader", shader, "--light", "0.3,0.5,0.8", "-q"]
         if textured:
             flags += ["--texture", texture]
         soft_png = os.path.join(args.out, name + "_softrast.png")

@@ -76,6 +76,7 @@ struct Options {
   std::string shader = "phong";
   std::optional<std::string> texture;
   glm::vec3 color{0.9f, 0.6f, 0.3f};
+  glm::vec3 light{0.3f, 0.5f, 0.8f};  // towards the light, world space
   float alpha = 1.0f;
   std::string cull = "back", front_face = "ccw", depth = "less", blend = "opaque";
   int frames = 0;
@@ -91,6 +92,7 @@ constexpr const char* kHelp =
     "  --size WxH          image size (800x600)\n"
     "  --up X,Y,Z          up direction (0,1,0)\n"
     "  --fov DEG           vertical field of view, gluPerspective (45)\n"
+    "  --light X,Y,Z       direction towards the light, world space (0.3,0.5,0.8)\n"
     "  --ortho L,R,B,T     glOrtho box instead of a perspective\n"
     "  --shader NAME       flat, gouraud, texture, phong, normals or wireframe (phong)\n"
     "  --texture PATH      PNG/TGA texture for texture and phong\n"
@@ -171,6 +173,9 @@ bool apply_flag(const std::string& flag, const std::string& value, Options& o) {
     o.target = parse_vec3(flag, value);
   } else if (flag == "--up") {
     o.up = parse_vec3(flag, value);
+  } else if (flag == "--light") {
+    o.light = parse_vec3(flag, value);
+    if (!(glm::length(o.light) > 1.0e-6f)) usage_error("--light: the direction must not be zero");
   } else if (flag == "--fov") {
     o.fov = parse_float(flag, value);
   } else if (flag == "--near") {
@@ -632,7 +637,7 @@ glm::mat4 view_projection(const Options& o) {
 void set_uniforms(GLuint program, const Options& o) {
   glUseProgram(program);
   glm::mat4 mvp = view_projection(o);
-  glm::vec3 light = glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f));
+  glm::vec3 light = glm::normalize(o.light);
   glUniformMatrix4fv(glGetUniformLocation(program, "u_mvp"), 1, GL_FALSE, glm::value_ptr(mvp));
   glUniform3fv(glGetUniformLocation(program, "u_albedo"), 1, glm::value_ptr(o.color));
   glUniform3fv(glGetUniformLocation(program, "u_light"), 1, glm::value_ptr(light));

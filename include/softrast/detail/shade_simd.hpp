@@ -204,16 +204,19 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
     z = simd::select(z >= F(0.0f), z, F(0.0f));  // NaN
     if (depth_test) f.live = f.live & depth_passes<N>(depth_func, z, stored);
   }
-  if (!simd::any(f.live)) return;
+  const uint32_t live = simd::bits(f.live);
+  if (live == 0) return;
   if (depth_test && depth_write) {
-    F out = simd::select(f.live, z, stored);
-    simd::store_block(depth_at, stride, out);
+    simd::store_block(depth_at, stride, live == 0xffffu ? z : simd::select(f.live, z, stored));
   }
   uint32_t* color_at = &fb.color_row(y)[x];
+  if (live == 0xffffu && blend_mode == BlendMode::kOpaque) {  // the common full block
+    simd::store_block(color_at, stride, pack_rgba8<N>(f.color));
+    return;
+  }
   I old = simd::load_block<I>(color_at, stride);
   I packed = blend<N>(blend_mode, f.color, old);
-  I out = simd::select(f.live, packed, old);
-  simd::store_block(color_at, stride, out);
+  simd::store_block(color_at, stride, simd::select(f.live, packed, old));
 }
 
 template <class S, int N>
