@@ -29,7 +29,8 @@ struct MeshInputs {
 
 // Samples at the uv in varyings (i, i + 1), with their derivatives when the filter needs them.
 template <int N>
-simd::Vec4<N> sample_with_derivatives(const Texture& t, const Sampler& s, const Fragments<N>& f,
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_with_derivatives(const Texture& t, const Sampler& s,
+                                                           const Fragments<N>& f,
                                       int i) {
   simd::Vec2<N> uv = f.vec2(i);
   if (s.filter != Filter::kTrilinear) return sample<N>(t, s, uv);
