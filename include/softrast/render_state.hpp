@@ -38,6 +38,12 @@ struct RenderState {
   // Added to every window depth before the depth test (like a polygon offset in depth units);
   // a small negative value lets a wireframe overlay win against its own filled surface.
   float depth_bias = 0.0f;
+  // glPolygonOffset for triangles drawn as edges (wireframe): each edge's depth moves by
+  // factor * m + units * 2^-24, where m is the triangle's largest depth slope in depth units per
+  // pixel, max(|dz/dx|, |dz/dy|). Negative values pull the edges towards the viewer, so that an
+  // overlay drawn over its own filled triangles keeps every pixel while hidden edges stay hidden.
+  float polygon_offset_factor = 0.0f;
+  float polygon_offset_units = 0.0f;
   // Threads a draw may use: 0 for every hardware thread. The image is the same for every value.
   int threads = 0;
   // The slow, obviously correct oracle: one thread, every primitive set up, rasterized and shaded

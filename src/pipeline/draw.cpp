@@ -3,6 +3,9 @@
 // the fragment program. Filled triangles take the binned path (binned_draw.cpp), on the calling
 // thread alone when threads = 1; lines, points, wireframe and RenderState::reference_path run
 // here in submission order: the single-threaded reference the binned path must match bit for bit.
+#include <algorithm>
+#include <cmath>
+
 #include "pipeline/draw_internal.hpp"
 #include "softrast/detail/parallel.hpp"
 #include "softrast/framebuffer.hpp"
@@ -21,6 +24,7 @@ class SerialDraw {
  private:
   void filled_triangle(const WindowVertex& w0, const WindowVertex& w1, const WindowVertex& w2);
   void wire_triangle(const WindowVertex& w0, const WindowVertex& w1, const WindowVertex& w2);
+  float polygon_offset(const WindowVertex (&v)[3], int64_t area_fx16) const;
   void line(const WindowVertex& a, const WindowVertex& b);
   void point(const WindowVertex& w);
 
@@ -75,9 +79,34 @@ void SerialDraw::wire_triangle(const WindowVertex& w0, const WindowVertex& w1,
   int64_t area = signed_area_fx16(w0, w1, w2);
   if (area == 0 && state_.cull != CullMode::kNone) return;
   if (is_culled(area, state_.cull, state_.front_face)) return;
-  line(w0, w1);
-  line(w1, w2);
-  line(w2, w0);
+  if (state_.polygon_offset_factor == 0.0f && state_.polygon_offset_units == 0.0f) {
+    line(w0, w1);
+    line(w1, w2);
+    line(w2, w0);
+    return;
+  }
+  WindowVertex v[3] = {w0, w1, w2};
+  float offset = polygon_offset(v, area);
+  for (WindowVertex& w : v) w.z = std::clamp(w.z + offset, 0.0f, 1.0f);
+  line(v[0], v[1]);
+  line(v[1], v[2]);
+  line(v[2], v[0]);
+}
+
+// glPolygonOffset's offset for the triangle: factor * max(|dz/dx|, |dz/dy|) + units * r, with
+// the slopes of the triangle's depth plane in depth per pixel and r = 2^-24 (a 24-bit buffer's
+// step, as the reference renderer has). A degenerate triangle has no slope.
+float SerialDraw::polygon_offset(const WindowVertex (&v)[3], int64_t area_fx16) const {
+  float slope = 0.0f;
+  if (area_fx16 != 0) {
+    double x1 = double(v[1].x - v[0].x) / kSubpixelOne, y1 = double(v[1].y - v[0].y) / kSubpixelOne;
+    double x2 = double(v[2].x - v[0].x) / kSubpixelOne, y2 = double(v[2].y - v[0].y) / kSubpixelOne;
+    double z1 = double(v[1].z) - v[0].z, z2 = double(v[2].z) - v[0].z;
+    double area2 = double(area_fx16) / (double(kSubpixelOne) * kSubpixelOne);
+    double dzdx = (z1 * y2 - z2 * y1) / area2, dzdy = (z2 * x1 - z1 * x2) / area2;
+    slope = float(std::max(std::abs(dzdx), std::abs(dzdy)));
+  }
+  return state_.polygon_offset_factor * slope + state_.polygon_offset_units * 0x1p-24f;
 }
 
 void SerialDraw::line(const WindowVertex& a, const WindowVertex& b) {

@@ -121,7 +121,12 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
     wire.blend = BlendMode::kOpaque;
     wire.depth_write = false;
     wire.depth_func = DepthFunc::kLessEqual;
-    wire.depth_bias = -1.0e-4f;
+    // A line's depth is interpolated along the line, not at the pixel centre the filled
+    // triangle was sampled at: up to half a pixel of the triangle's slope apart. One slope
+    // (and a few steps) towards the viewer keeps every visible edge pixel, and hides edges
+    // behind other surfaces.
+    wire.polygon_offset_factor = -1.0f;
+    wire.polygon_offset_units = -4.0f;
     std::span<const uint32_t> all(mesh.indices);
     draw_run(framebuffer, wire, mesh, camera, mvp, all, Surface{options.wire_color, nullptr},
              options, ShaderKind::kWireframe);
