@@ -165,10 +165,11 @@ class BinnedDraw {
     int64_t area = signed_area_fx16(a, b, c);
     if (area == 0 || is_culled(area, state_.cull, state_.front_face)) return;
     uint32_t offset = chunk.records.allocate(record_bytes_);
-    TriRecord* rec = new (chunk.records.at(offset)) TriRecord;
+    // TriRecord is an implicit-lifetime aggregate living in allocated bytes; every field is
+    // written below.
+    TriRecord* rec = chunk.records.at(offset);
     const WindowVertex* ordered[3];
-    if (!setup_triangle_coverage(a, b, c, state_.cull, state_.front_face, geometry_.scissor(),
-                                 rec->coverage, ordered, area)) {
+    if (!setup_triangle_coverage(a, b, c, area, geometry_.scissor(), rec->coverage, ordered)) {
       chunk.records.release_last(record_bytes_);
       return;
     }
