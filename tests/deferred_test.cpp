@@ -213,6 +213,26 @@ TEST(Deferred, SeveralDrawsAndNearClippingEqualReference) {
   }
 }
 
+TEST(Deferred, SeveralBatchesEqualReference) {
+  // 36,030 triangles, more than one batch of the binned path (each batch resolves and shades its
+  // tiles, then the next one tests against the depth the previous one wrote): a few large
+  // triangles, then small ones at random depths (random ones shrunk around their first vertex).
+  Scene scene = overdraw_scene(30, 41, true);
+  Scene small = overdraw_scene(36000, 42, false);
+  for (size_t i = 0; i + 2 < small.positions.size(); i += 3) {
+    glm::vec2 c(small.positions[i]);
+    glm::vec4 v[3];
+    for (int k = 0; k < 3; ++k) {
+      glm::vec4 p = small.positions[i + k];
+      v[k] = glm::vec4(c + 0.05f * (glm::vec2(p) - c), p.z, p.w);
+    }
+    scene.triangle(v[0], v[1], v[2], small.colors[i]);
+  }
+  for (DepthFunc func : {DepthFunc::kLess, DepthFunc::kLessEqual}) {
+    expect_same_as_reference({&scene}, opaque_state(func), "several batches");
+  }
+}
+
 // Shades with a counting shader and returns how many pixels were shaded.
 template <class S>
 long count_shaded(const Scene& scene, const RenderState& state, int* visible = nullptr) {
