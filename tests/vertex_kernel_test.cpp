@@ -72,50 +72,5 @@ TEST(VertexKernel, EqualsTheScalarFrontEnd) {
   }
 }
 
-// The plane kernels against setup_triangle's scalar planes: the same Interpolants, bit for bit,
-// for every varying count, both windings and facings, tiny and huge triangles.
-TEST(VertexKernel, PlanesEqualTheScalarSetup) {
-  std::mt19937 rng(23);
-  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-  std::uniform_int_distribution<int32_t> coord(-(1 << 22), 1 << 22), near(-2000, 2000);
-  std::vector<float> varyings(3 * detail::kMaxVaryings);
-  for (int i = 0; i < 3000; ++i) {
-    int num_varyings = i % (detail::kMaxVaryings + 1);
-    detail::WindowVertex v[3];
-    for (int k = 0; k < 3; ++k) {
-      v[k].x = i % 2 ? coord(rng) : near(rng);
-      v[k].y = i % 2 ? coord(rng) : near(rng);
-      v[k].z = std::abs(unit(rng));
-      v[k].inv_w = 0.01f + std::abs(unit(rng)) * (i % 3 ? 1.0f : 1e5f);
-      v[k].varyings = &varyings[size_t(k) * detail::kMaxVaryings];
-    }
-    for (float& f : varyings) f = unit(rng) * (i % 5 ? 1.0f : 1e6f);
-    FrontFace face = i % 4 < 2 ? FrontFace::kCounterClockwise : FrontFace::kClockwise;
-    detail::TriangleSetup tri;
-    if (!detail::setup_triangle(v[0], v[1], v[2], num_varyings, CullMode::kNone, face,
-                                {-(1 << 23), -(1 << 23), 1 << 23, 1 << 23}, tri)) {
-      continue;
-    }
-    const detail::WindowVertex* ordered[3];
-    int64_t area = detail::signed_area_fx16(v[0], v[1], v[2]);
-    detail::TriangleCoverage coverage;
-    ASSERT_TRUE(detail::setup_triangle_coverage(v[0], v[1], v[2], area,
-                                                {-(1 << 23), -(1 << 23), 1 << 23, 1 << 23},
-                                                coverage, ordered));
-    for (int level = 0; level <= int(cpu_simd_level()); ++level) {
-      detail::Interpolants wide;
-      detail::plane_kernel(SimdLevel(level))(ordered, num_varyings, area, face, wide);
-      const detail::Interpolants& scalar = tri.interp;
-      auto same = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof(a)) == 0; };
-      bool equal = same(wide.x_ref, scalar.x_ref) && same(wide.y_ref, scalar.y_ref) &&
-                   same(wide.z, scalar.z) && same(wide.inv_w, scalar.inv_w) &&
-                   wide.num_varyings == scalar.num_varyings &&
-                   wide.front_facing == scalar.front_facing &&
-                   std::memcmp(wide.var, scalar.var, sizeof(detail::Plane) * num_varyings) == 0;
-      ASSERT_TRUE(equal) << simd_level_name(SimdLevel(level)) << " triangle " << i;
-    }
-  }
-}
-
 }  // namespace
 }  // namespace softrast

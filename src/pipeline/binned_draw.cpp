@@ -95,7 +95,6 @@ class BinnedDraw {
         cache_(draw_cache()) {
     deferred_ = deferred_shading_applies(state, program);
     kernels_ = tile_kernels(simd_level());
-    plane_kernel_ = plane_kernel(simd_level());
     record_bytes_ = record_bytes(geometry.num_varyings());
     const PixelRect& s = geometry.scissor();
     tiles_x_ = (s.x1 + kTileSize - 1) / kTileSize;
@@ -183,7 +182,8 @@ class BinnedDraw {
       return int64_t(std::max({v[0], v[1], v[2]})) - std::min({v[0], v[1], v[2]});
     };
     rec->small = extent(t.vx) <= kSmallTriangleFx8 && extent(t.vy) <= kSmallTriangleFx8;
-    plane_kernel_(ordered, geometry_.num_varyings(), area, state_.front_face, rec->interp());
+    setup_triangle_interpolants(ordered, geometry_.num_varyings(), area, state_.front_face,
+                                rec->interp());
     bin(chunk, t.bounds, offset);
   }
 
@@ -299,7 +299,6 @@ class BinnedDraw {
   DrawCache& cache_;
   bool deferred_ = false;
   TileKernels kernels_{};
-  PlaneKernelFn plane_kernel_ = nullptr;
   size_t record_bytes_ = 0;
   size_t num_chunks_ = 1;
   int tiles_x_ = 0, tiles_y_ = 0;

@@ -67,39 +67,3 @@ void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
     }
   }
 }
-
-// setup.cpp's setup_planes and setup_triangle_interpolants with planes in lanes: plane 0 is the
-// depth, 1 is 1/w, 2 + i is varying i / w (the product of two floats, exact in double).
-void setup_planes_wide(const WindowVertex* const v[3], int num_varyings, int64_t area,
-                       FrontFace front_face, Interpolants& out) {
-  int64_t area_abs = area < 0 ? -area : area;
-  double dx1 = double(v[1]->x - v[0]->x) / kSubpixelOne, dx2 = double(v[2]->x - v[0]->x) / kSubpixelOne;
-  double dy1 = double(v[1]->y - v[0]->y) / kSubpixelOne, dy2 = double(v[2]->y - v[0]->y) / kSubpixelOne;
-  double inv_area2 = double(kSubpixelOne) * kSubpixelOne / double(area_abs);
-  out.x_ref = float(double(v[0]->x) / kSubpixelOne);
-  out.y_ref = float(double(v[0]->y) / kSubpixelOne);
-  Plane* planes[2 + kMaxVaryings];
-  planes[0] = &out.z;
-  planes[1] = &out.inv_w;
-  for (int i = 0; i < num_varyings; ++i) planes[2 + i] = &out.var[i];
-  int count = 2 + num_varyings;
-  for (int first = 0; first < count; first += kD) {
-    D a[3] = {};
-    for (int k = 0; k < 3; ++k) {
-      for (int l = 0; l < kD; ++l) {
-        int p = std::min(first + l, count - 1);
-        a[k][l] = p == 0   ? double(v[k]->z)
-                  : p == 1 ? double(v[k]->inv_w)
-                           : double(v[k]->varyings[p - 2]) * v[k]->inv_w;
-      }
-    }
-    D da1 = a[1] - a[0], da2 = a[2] - a[0];
-    D dadx = (da1 * dy2 - da2 * dy1) * inv_area2;
-    D dady = (da2 * dx1 - da1 * dx2) * inv_area2;
-    for (int l = 0; l < kD && first + l < count; ++l) {
-      *planes[first + l] = {float(a[0][l]), float(dadx[l]), float(dady[l])};
-    }
-  }
-  out.num_varyings = num_varyings;
-  out.front_facing = is_front_facing(area, front_face);
-}

@@ -50,15 +50,4 @@ VertexKernelFn vertex_kernel(SimdLevel level) {
   }
 }
 
-PlaneKernelFn plane_kernel(SimdLevel level) {
-  switch (level) {
-    case SimdLevel::kAvx512:
-      return &avx512::setup_planes_wide;
-    case SimdLevel::kAvx2:
-      return &avx2::setup_planes_wide;
-    default:
-      return &sse2::setup_planes_wide;
-  }
-}
-
 }  // namespace softrast::detail

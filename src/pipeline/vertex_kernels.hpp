@@ -1,7 +1,6 @@
-// pipeline/vertex_kernels.hpp: the binned draw's front end in SIMD: each vertex's clip outcode
-// and, inside the clip volume, its snapped window position, several vertices at once in double
-// precision; and a triangle's plane equations, several planes at once. One source
-// (vertex_kernel.inl) compiled for SSE2, AVX2 and AVX-512.
+// pipeline/vertex_kernels.hpp: the binned draw's per-vertex front end in SIMD: each vertex's clip
+// outcode and, inside the clip volume, its snapped window position, several vertices at once in
+// double precision. One source (vertex_kernel.inl) compiled for SSE2, AVX2 and AVX-512.
 //
 // Bit for bit the scalar GeometryStage::vertex_code and window_vertex (Viewport::to_window): the
 // same IEEE double operations in the same order, the same rounding (the current mode, like
@@ -12,7 +11,6 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "raster/setup.hpp"
 #include "softrast/simd_level.hpp"
 
 namespace softrast::detail {
@@ -36,11 +34,5 @@ struct VertexBatch {
 // Transforms vertices [begin, end) of the batch.
 using VertexKernelFn = void (*)(const VertexBatch& batch, size_t begin, size_t end);
 VertexKernelFn vertex_kernel(SimdLevel level);
-
-// setup_triangle_interpolants (raster/setup.hpp) with the planes (depth, 1/w, varying/w) in the
-// lanes: per plane the same double operations in the same order, so the same floats.
-using PlaneKernelFn = void (*)(const WindowVertex* const ordered[3], int num_varyings,
-                               int64_t area, FrontFace front_face, Interpolants& out);
-PlaneKernelFn plane_kernel(SimdLevel level);
 
 }  // namespace softrast::detail
