@@ -393,7 +393,7 @@ const BadInput kBadInputs[] = {
     {"UnknownRaster", "--raster raytrace -o out.png"},
     {"NegativeThreads", "--threads -1 -o out.png"},
     {"NonNumericThreads", "--threads many -o out.png"},
-    {"UnknownFilter", "--filter trilinear -o out.png"},
+    {"UnknownFilter", "--filter anisotropic -o out.png"},
     {"UnknownWrap", "--wrap border -o out.png"},
     {"FramesZero", "--frames 0 -o out.png"},
     {"FramesNegative", "--frames=-2 -o out.png"},

@@ -49,7 +49,7 @@ void define_shading_flags(CLI::App& app, RawArgs& a) {
                  "Direction towards the light, in world space (default 0.3,0.5,0.8)")
       ->type_name("X,Y,Z");
   app.add_option("--alpha", a.alpha, "Output alpha in [0, 1] (default 1)")->type_name("A");
-  app.add_option("--filter", a.filter, "Texture filter: nearest or bilinear (default bilinear)")
+  app.add_option("--filter", a.filter, "Texture filter: nearest, bilinear or trilinear (mipmapped) (default bilinear)")
       ->type_name("MODE");
   app.add_option("--wrap", a.wrap, "Texture wrap: repeat, clamp or mirror (default repeat)")
       ->type_name("MODE");

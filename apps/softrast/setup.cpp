@@ -72,8 +72,9 @@ constexpr std::array<Named<BlendMode>, 3> kBlendModes = {
     {{"opaque", BlendMode::kOpaque}, {"alpha", BlendMode::kAlpha}, {"add", BlendMode::kAdditive}}};
 constexpr std::array<Named<RasterAlgorithm>, 2> kRasterAlgorithms = {
     {{"edge", RasterAlgorithm::kEdgeEquations}, {"scanline", RasterAlgorithm::kScanline}}};
-constexpr std::array<Named<Filter>, 2> kFilters = {
-    {{"nearest", Filter::kNearest}, {"bilinear", Filter::kBilinear}}};
+constexpr std::array<Named<Filter>, 3> kFilters = {{{"nearest", Filter::kNearest},
+                                                     {"bilinear", Filter::kBilinear},
+                                                     {"trilinear", Filter::kTrilinear}}};
 constexpr std::array<Named<Wrap>, 3> kWraps = {
     {{"repeat", Wrap::kRepeat}, {"clamp", Wrap::kClampToEdge}, {"mirror", Wrap::kMirroredRepeat}}};
 constexpr std::array<ShaderKind, 7> kShaderKinds = {
