@@ -117,8 +117,9 @@ struct PhongShader {
   }
   // x^32 by five squarings (kShininess is 32).
   template <int N>
-  static simd::Float<N> pow_shininess(simd::Float<N> x) {
+  static simd::Float<N> pow_shininess(const simd::Float<N>& base) {
     static_assert(kShininess == 32.0f);
+    simd::Float<N> x = base;
     for (int k = 0; k < 5; ++k) x = x * x;
     return x;
   }

@@ -3,6 +3,11 @@
 // Internal: included through softrast/shader.hpp; shaders call softrast::sample().
 #pragma once
 
+// Wide vectors are passed by value between inlined helpers; GCC notes that the ABI of such
+// parameters changed in GCC 4.6, which cannot matter here (nothing crosses a library boundary).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 #include <cstring>
 
 #include "softrast/simd.hpp"
@@ -168,3 +173,5 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler&
 }
 
 }  // namespace softrast
+
+#pragma GCC diagnostic pop
