@@ -23,7 +23,7 @@
 #include <algorithm>
 #include <atomic>
 #include <memory>
-#include <new>
+#include <span>
 #include <vector>
 
 #include "pipeline/draw_internal.hpp"
@@ -99,21 +99,25 @@ class BinnedDraw {
     const PixelRect& s = geometry.scissor();
     tiles_x_ = (s.x1 + kTileSize - 1) / kTileSize;
     tiles_y_ = (s.y1 + kTileSize - 1) / kTileSize;
-    cache_.chunks.resize(threads == 1 ? 1 : size_t(threads) * kChunksPerThread);
-    for (Chunk& c : cache_.chunks) c.bins.resize(size_t(tiles_x_) * size_t(tiles_y_));
+    // The cache keeps the most chunks any draw used (one thread needs one), so alternating
+    // thread counts does not free and reallocate arenas.
+    num_chunks_ = threads == 1 ? 1 : size_t(threads) * kChunksPerThread;
+    if (cache_.chunks.size() < num_chunks_) cache_.chunks.resize(num_chunks_);
+    for (size_t c = 0; c < num_chunks_; ++c) {
+      cache_.chunks[c].bins.resize(size_t(tiles_x_) * size_t(tiles_y_));
+    }
   }
 
   void draw(const uint32_t* indices, size_t index_count) {
     transform_vertices();
-    std::vector<Chunk>& chunks = cache_.chunks;
     size_t triangles = index_count / 3;
     for (size_t first = 0; first < triangles; first += kBatchTriangles) {
       size_t count = std::min(kBatchTriangles, triangles - first);
-      size_t per_chunk = (count + chunks.size() - 1) / chunks.size();
-      parallel_for(chunks.size(), threads_, [&](size_t c) {
+      size_t per_chunk = (count + num_chunks_ - 1) / num_chunks_;
+      parallel_for(num_chunks_, threads_, [&](size_t c) {
         size_t begin = std::min(first + count, first + c * per_chunk);
         size_t end = std::min(first + count, begin + per_chunk);
-        setup_chunk(chunks[c], indices, begin, end);
+        setup_chunk(cache_.chunks[c], indices, begin, end);
       });
       raster_tiles();
     }
@@ -165,10 +169,11 @@ class BinnedDraw {
     int64_t area = signed_area_fx16(a, b, c);
     if (area == 0 || is_culled(area, state_.cull, state_.front_face)) return;
     uint32_t offset = chunk.records.allocate(record_bytes_);
-    TriRecord* rec = new (chunk.records.at(offset)) TriRecord;
+    // TriRecord is an implicit-lifetime aggregate living in allocated bytes; every field is
+    // written below.
+    TriRecord* rec = chunk.records.at(offset);
     const WindowVertex* ordered[3];
-    if (!setup_triangle_coverage(a, b, c, state_.cull, state_.front_face, geometry_.scissor(),
-                                 rec->coverage, ordered, area)) {
+    if (!setup_triangle_coverage(a, b, c, area, geometry_.scissor(), rec->coverage, ordered)) {
       chunk.records.release_last(record_bytes_);
       return;
     }
@@ -204,7 +209,7 @@ class BinnedDraw {
     size_t workers = std::min<size_t>(size_t(threads_), tiles);
     if (deferred_) {
       size_t records = 0;  // a tile holds at most every record of the batch once
-      for (const Chunk& c : cache_.chunks) records += c.records.used() / record_bytes_;
+      for (const Chunk& c : chunks()) records += c.records.used() / record_bytes_;
       if (cache_.scratch.size() < workers) cache_.scratch.resize(workers);
       for (size_t w = 0; w < workers; ++w) {
         if (!cache_.scratch[w]) cache_.scratch[w] = std::make_unique<DeferredScratch>();
@@ -227,7 +232,7 @@ class BinnedDraw {
     job.program = &program_;
     job.target = &target_;
     Shading shading(program_, target_);
-    for (const Chunk& chunk : cache_.chunks) {
+    for (const Chunk& chunk : chunks()) {
       const std::vector<uint32_t>& bin = chunk.bins[tile];
       if (bin.empty()) continue;
       if (state_.raster == RasterAlgorithm::kEdgeEquations) {
@@ -245,7 +250,7 @@ class BinnedDraw {
   // first, in submission order, then one shading call per block and winning triangle.
   void resolve_and_shade_tile(size_t tile, DeferredScratch& scratch) {
     bool any = false;
-    for (const Chunk& chunk : cache_.chunks) any |= !chunk.bins[tile].empty();
+    for (const Chunk& chunk : chunks()) any |= !chunk.bins[tile].empty();
     if (!any) return;
     TileVisibility& visibility = scratch.visibility;
     TileJob job;
@@ -254,7 +259,7 @@ class BinnedDraw {
     job.less_equal = state_.depth_func == DepthFunc::kLessEqual;
     job.interps = scratch.interps.data();
     visibility.begin(*target_.framebuffer, job.region);
-    for (const Chunk& chunk : cache_.chunks) {
+    for (const Chunk& chunk : chunks()) {
       const std::vector<uint32_t>& bin = chunk.bins[tile];
       if (bin.empty()) continue;
       if (state_.raster == RasterAlgorithm::kEdgeEquations) {
@@ -279,6 +284,9 @@ class BinnedDraw {
     visibility.reset();
   }
 
+  // The chunks of this draw.
+  std::span<const Chunk> chunks() const { return {cache_.chunks.data(), num_chunks_}; }
+
   static const TriRecord& record(const Chunk& chunk, uint32_t offset) {
     return *reinterpret_cast<const TriRecord*>(chunk.records.data() + offset);
   }
@@ -292,6 +300,7 @@ class BinnedDraw {
   bool deferred_ = false;
   TileKernels kernels_{};
   size_t record_bytes_ = 0;
+  size_t num_chunks_ = 1;
   int tiles_x_ = 0, tiles_y_ = 0;
 };
 

@@ -38,10 +38,16 @@ struct TileVisibility {
   void begin(Framebuffer& fb, const PixelRect& tile_region);
   // The block of pixel (x, y), its depth loaded.
   int block(int x, int y) {
-    int b = ((y - region.y0) >> 2) * kBlocksPerRow + ((x - region.x0) >> 2);
-    if (!(touched[b >> 6] >> (b & 63) & 1)) load_block(b);
+    int b = block_index(x, y);
+    if (!loaded(b)) load_block(b);
     return b;
   }
+  int block_index(int x, int y) const {
+    return ((y - region.y0) >> 2) * kBlocksPerRow + ((x - region.x0) >> 2);
+  }
+  bool loaded(int b) const { return touched[b >> 6] >> (b & 63) & 1; }
+  // For a caller that filled depth[b] itself (the tile kernels, with one wide store).
+  void mark_loaded(int b) { touched[b >> 6] |= uint64_t(1) << (b & 63); }
   // Writes the touched blocks' depth back to the framebuffer (before shading: the resolved
   // contract says depth is already written).
   void store_depth() const;

@@ -98,18 +98,14 @@ int64_t signed_area_fx16(const WindowVertex& v0, const WindowVertex& v1, const W
 }
 
 bool setup_triangle_coverage(const WindowVertex& v0, const WindowVertex& v1,
-                             const WindowVertex& v2, CullMode cull, FrontFace front_face,
-                             const PixelRect& scissor, TriangleCoverage& out,
-                             const WindowVertex* ordered[3], int64_t& area) {
+                             const WindowVertex& v2, int64_t area, const PixelRect& scissor,
+                             TriangleCoverage& out, const WindowVertex* ordered[3]) {
   // Clipping keeps every vertex inside the guard band; the bit budget of the edge functions
   // (fixed_point.hpp) depends on it.
   for (const WindowVertex* v : {&v0, &v1, &v2}) {
     SOFTRAST_CHECK_LT(std::llabs(v->x), kMaxCoordFx8);
     SOFTRAST_CHECK_LT(std::llabs(v->y), kMaxCoordFx8);
   }
-  area = signed_area_fx16(v0, v1, v2);
-  if (area == 0) return false;  // zero area: back-facing by convention, and covers nothing
-  if (is_culled(area, cull, front_face)) return false;
   bool ccw = area < 0;  // counter-clockwise as seen in the image (y down)
 
   // Reorder to clockwise so that every edge function is positive inside.
@@ -138,11 +134,11 @@ void setup_triangle_interpolants(const WindowVertex* const ordered[3], int num_v
 bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
                     int num_varyings, CullMode cull, FrontFace front_face, const PixelRect& scissor,
                     TriangleSetup& out) {
+  int64_t area = signed_area_fx16(v0, v1, v2);
+  if (area == 0) return false;  // zero area: back-facing by convention, and covers nothing
+  if (is_culled(area, cull, front_face)) return false;
   const WindowVertex* ordered[3];
-  int64_t area = 0;
-  if (!setup_triangle_coverage(v0, v1, v2, cull, front_face, scissor, out, ordered, area)) {
-    return false;
-  }
+  if (!setup_triangle_coverage(v0, v1, v2, area, scissor, out, ordered)) return false;
   setup_triangle_interpolants(ordered, num_varyings, area, front_face, out.interp);
   return true;
 }

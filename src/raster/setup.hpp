@@ -76,14 +76,14 @@ bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const Window
                     TriangleSetup& out);
 
 // setup_triangle in two steps, for producers that store the interpolants elsewhere (the bins'
-// compact records). The first culls by the snapped area before any other work, then reorders
-// the vertices clockwise into `ordered` and fills the coverage; false as setup_triangle. The
-// second fills the interpolants (`area` is the first's signed area). setup_triangle is exactly
-// these two calls, so every path sets triangles up identically.
+// compact records) and cull before anything else. The first takes the snapped signed area
+// (signed_area_fx16, non-zero, of a triangle that is_culled kept), reorders the vertices
+// clockwise into `ordered` and fills the coverage; false when it covers no pixel of `scissor`.
+// The second fills the interpolants. setup_triangle is the area, the cull and these two calls, so
+// every path sets triangles up identically.
 bool setup_triangle_coverage(const WindowVertex& v0, const WindowVertex& v1,
-                             const WindowVertex& v2, CullMode cull, FrontFace front_face,
-                             const PixelRect& scissor, TriangleCoverage& out,
-                             const WindowVertex* ordered[3], int64_t& area);
+                             const WindowVertex& v2, int64_t area, const PixelRect& scissor,
+                             TriangleCoverage& out, const WindowVertex* ordered[3]);
 void setup_triangle_interpolants(const WindowVertex* const ordered[3], int num_varyings,
                                  int64_t area, FrontFace front_face, Interpolants& out);
 
