@@ -338,6 +338,8 @@ const BadInput kBadInputs[] = {
     {"MissingModel", "missing.obj -o out.png"},
     {"EmptyObj", "empty.obj -o out.png"},
     {"FaceIndexOutOfRange", "bad_index.obj -o out.png"},
+    {"ModelIsDevZero", "/dev/zero -o out.png"},
+    {"ModelIsAFolder", ". -o out.png"},
     {"GarbageTexture", "quad.obj --texture garbage.png -o out.png"},
     {"MissingTexture", "quad.obj --texture missing.png -o out.png"},
     {"TextureIsAnObj", "--texture quad.obj -o out.png"},
