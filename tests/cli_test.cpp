@@ -24,6 +24,9 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
 #include "softrast/framebuffer.hpp"
 #include "softrast/image.hpp"
 
@@ -265,6 +268,25 @@ TEST_F(CliTest, UnsupportedTextureFormatIsOneErrorLine) {
   EXPECT_EQ(files(), fixtures_and({"deep.pgm"}));
 }
 
+// Without --light the light follows the camera: (0.3, 0.5, 0.8) in the camera's frame (x right,
+// y up, z towards the viewer), so a surface facing the viewer is lit from any side.
+TEST_F(CliTest, DefaultLightIsAHeadlight) {
+  for (glm::vec3 eye : {glm::vec3(0, 0, 5), glm::vec3(3, 1, 4), glm::vec3(-2, -3, 1)}) {
+    glm::vec3 forward = glm::normalize(-eye), up(0, 1, 0);
+    glm::vec3 right = glm::normalize(glm::cross(forward, up));
+    glm::vec3 true_up = glm::cross(right, forward);
+    glm::vec3 light = glm::normalize(0.3f * right + 0.5f * true_up - 0.8f * forward);
+    float lit = 0.15f + 0.85f * std::max(light.z, 0.0f);  // the quad's normal is +z
+    std::string flags = "quad.obj --size 32x32 --shader gouraud --eye " +
+                        std::to_string(eye.x) + "," + std::to_string(eye.y) + "," +
+                        std::to_string(eye.z) + " --target 0,0,0 -o lit.png";
+    CliRun r = run(flags);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NEAR(pixel(load("lit.png", 32, 32), 16, 16)[0], to_unorm8(0.9f * lit), 1)
+        << "eye " << eye.x << "," << eye.y << "," << eye.z;
+  }
+}
+
 TEST_F(CliTest, HelpMentionsEveryFlag) {
   for (const char* args : {"--help", "render --help", "-h"}) {
     CliRun r = run(args);
@@ -452,7 +474,7 @@ const BadInput kBadInputs[] = {
     {"UnknownRaster", "--raster raytrace -o out.png"},
     {"NegativeThreads", "--threads -1 -o out.png"},
     {"NonNumericThreads", "--threads many -o out.png"},
-    {"UnknownFilter", "--filter trilinear -o out.png"},
+    {"UnknownFilter", "--filter anisotropic -o out.png"},
     {"UnknownWrap", "--wrap border -o out.png"},
     {"FramesZero", "--frames 0 -o out.png"},
     {"FramesNegative", "--frames=-2 -o out.png"},

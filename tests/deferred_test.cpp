@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "softrast/shader.hpp"
+#include "softrast/simd_level.hpp"
 
 namespace softrast {
 namespace {
@@ -151,13 +152,18 @@ Buffers render(const std::vector<const Scene*>& scenes, RenderState state, int t
   return read_back(fb);
 }
 
+// One and two threads, with the kernels of every SIMD level this CPU has.
 void expect_same_as_reference(const std::vector<const Scene*>& scenes, const RenderState& state,
                               const char* what) {
   Buffers reference = render(scenes, state, 1, true);
-  for (int threads : {1, 2}) {
-    EXPECT_TRUE(render(scenes, state, threads, false) == reference)
-        << what << ", threads " << threads;
+  for (int level = 0; level <= int(cpu_simd_level()); ++level) {
+    set_simd_level(SimdLevel(level));
+    for (int threads : {1, 2}) {
+      EXPECT_TRUE(render(scenes, state, threads, false) == reference)
+          << what << ", threads " << threads << ", " << simd_level_name(SimdLevel(level));
+    }
   }
+  set_simd_level(cpu_simd_level());
 }
 
 RenderState opaque_state(DepthFunc func) {

@@ -92,18 +92,36 @@ INSTANTIATE_TEST_SUITE_P(AllShaders, SimdLevelGolden,
                          });
 
 // The wide sampler against Texture::sample, lane by lane, at one level (N lanes per vector).
+// Derivatives for the trilinear case: each lane's uv changes by (lane-dependent) amounts that
+// span magnification to far past the last level.
+glm::vec2 test_ddx(size_t i) {
+  return {std::ldexp(1.0f, int(i % 23) - 12) * 0.7f, std::ldexp(1.0f, int(i % 7) - 9)};
+}
+glm::vec2 test_ddy(size_t i) {
+  return {-std::ldexp(1.0f, int(i % 5) - 10), std::ldexp(1.0f, int(i % 19) - 11) * 1.3f};
+}
+
 template <int N>
 void expect_sampler_matches_scalar(const Texture& texture, const Sampler& sampler,
                                    const std::vector<glm::vec2>& uvs) {
   for (size_t first = 0; first + simd::kLanes <= uvs.size(); first += simd::kLanes) {
-    simd::Vec2<N> uv;
+    simd::Vec2<N> uv, dx, dy;
     for (int i = 0; i < simd::kLanes; ++i) {
       uv.x.set_lane(i, uvs[first + i].x);
       uv.y.set_lane(i, uvs[first + i].y);
+      dx.x.set_lane(i, test_ddx(first + i).x);
+      dx.y.set_lane(i, test_ddx(first + i).y);
+      dy.x.set_lane(i, test_ddy(first + i).x);
+      dy.y.set_lane(i, test_ddy(first + i).y);
     }
-    simd::Vec4<N> got = sample<N>(texture, sampler, uv);
+    simd::Vec4<N> got = sampler.filter == Filter::kTrilinear
+                            ? sample<N>(texture, sampler, uv, dx, dy)
+                            : sample<N>(texture, sampler, uv);
     for (int i = 0; i < simd::kLanes; ++i) {
-      glm::vec4 want = texture.sample(sampler, uvs[first + i]);
+      glm::vec4 want = sampler.filter == Filter::kTrilinear
+                           ? texture.sample(sampler, uvs[first + i], test_ddx(first + i),
+                                            test_ddy(first + i))
+                           : texture.sample(sampler, uvs[first + i]);
       ASSERT_EQ(got.x.lane(i), want.r) << "uv " << uvs[first + i].x << "," << uvs[first + i].y;
       ASSERT_EQ(got.y.lane(i), want.g);
       ASSERT_EQ(got.z.lane(i), want.b);
@@ -150,9 +168,9 @@ TEST(SimdSampler, MatchesScalarSamplingBitForBitAtEveryLevel) {
   for (float special : {nan, inf, -inf, 1.0e30f, -0.0f, 0.5f}) {
     for (int i = 0; i < 16; ++i) uvs.push_back({special, near_range(rng)});
   }
-  for (auto [w, h] : {std::pair{64, 32}, std::pair{37, 19}, std::pair{1, 1}}) {
+  for (auto [w, h] : {std::pair{64, 32}, std::pair{37, 19}, std::pair{1, 1}, std::pair{256, 5}}) {
     Texture texture = noise_texture(w, h, unsigned(w * 100 + h));
-    for (Filter filter : {Filter::kNearest, Filter::kBilinear}) {
+    for (Filter filter : {Filter::kNearest, Filter::kBilinear, Filter::kTrilinear}) {
       for (Wrap wrap : {Wrap::kRepeat, Wrap::kClampToEdge, Wrap::kMirroredRepeat}) {
         Sampler sampler{filter, wrap, wrap};
         SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + " filter " +

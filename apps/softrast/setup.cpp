@@ -3,6 +3,9 @@
 
 #include "setup.hpp"
 
+#include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -72,8 +75,9 @@ constexpr std::array<Named<BlendMode>, 3> kBlendModes = {
     {{"opaque", BlendMode::kOpaque}, {"alpha", BlendMode::kAlpha}, {"add", BlendMode::kAdditive}}};
 constexpr std::array<Named<RasterAlgorithm>, 2> kRasterAlgorithms = {
     {{"edge", RasterAlgorithm::kEdgeEquations}, {"scanline", RasterAlgorithm::kScanline}}};
-constexpr std::array<Named<Filter>, 2> kFilters = {
-    {{"nearest", Filter::kNearest}, {"bilinear", Filter::kBilinear}}};
+constexpr std::array<Named<Filter>, 3> kFilters = {{{"nearest", Filter::kNearest},
+                                                     {"bilinear", Filter::kBilinear},
+                                                     {"trilinear", Filter::kTrilinear}}};
 constexpr std::array<Named<Wrap>, 3> kWraps = {
     {{"repeat", Wrap::kRepeat}, {"clamp", Wrap::kClampToEdge}, {"mirror", Wrap::kMirroredRepeat}}};
 constexpr std::array<ShaderKind, 7> kShaderKinds = {
@@ -251,6 +255,7 @@ Result<JobSpec> interpret(const RawArgs& args) {
   if (!e.status().ok()) return e.status();
   spec.model = args.model;
   spec.texture = args.texture;
+  spec.headlight = !args.light;
   spec.quiet = args.quiet;
   return spec;
 }
@@ -270,6 +275,11 @@ Result<Job> prepare(const JobSpec& spec) {
   // Allocated last: up to 2 GiB for the largest size, not worth spending on a bad model.
   Result<Framebuffer> framebuffer = Framebuffer::create(spec.width, spec.height);
   if (!framebuffer) return framebuffer.status();
+  if (spec.headlight) {
+    // From the camera's frame to the world: the transpose of the view matrix's rotation.
+    glm::mat3 camera_to_world = glm::transpose(glm::mat3(scene->camera.view()));
+    options.light_direction = camera_to_world * glm::normalize(options.light_direction);
+  }
   Job job(std::move(*scene), std::move(*framebuffer));
   job.options = std::move(options);
   job.output = spec.output;

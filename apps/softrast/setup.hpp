@@ -27,6 +27,9 @@ struct JobSpec {
   CameraFlags camera;
   RenderOptions options;  // all but the texture
   std::optional<std::string> texture;
+  // No --light: the light follows the camera (options.light_direction is then taken in the
+  // camera's frame: x right, y up, z towards the viewer).
+  bool headlight = true;
   int frames = 0;  // 0: one untimed render
   bool quiet = false;
 };

@@ -11,6 +11,11 @@
 // reference, so no wide vector crosses a call boundary between code built for different targets.
 #pragma once
 
+// Wide vectors are passed by value between inlined helpers; GCC notes that the ABI of such
+// parameters changed in GCC 4.6, which cannot matter here (nothing crosses a library boundary).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 #include <immintrin.h>
 
 #include <cstdint>
@@ -528,3 +533,5 @@ SOFTRAST_SIMD_INLINE Vec3<N> normalize(const Vec3<N>& v) {
 }
 
 }  // namespace softrast::simd
+
+#pragma GCC diagnostic pop

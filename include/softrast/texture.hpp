@@ -2,8 +2,10 @@
 // Texel rows are stored bottom-up, as after an OpenGL upload: v = 0 is the last row of the file.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -14,7 +16,9 @@
 
 namespace softrast {
 
-enum class Filter { kNearest, kBilinear };
+// kTrilinear is GL_LINEAR_MIPMAP_LINEAR: bilinear in the two mip levels around the level of
+// detail, blended; the level of detail comes from the texture coordinates' screen derivatives.
+enum class Filter { kNearest, kBilinear, kTrilinear };
 enum class Wrap { kRepeat, kClampToEdge, kMirroredRepeat };
 
 struct Sampler {
@@ -23,8 +27,32 @@ struct Sampler {
   Wrap wrap_v = Wrap::kRepeat;
 };
 
-// An RGBA8 texture. Texel (i, j) has its centre at ((i + 0.5) / width, (j + 0.5) / height) in
-// (u, v); j = 0 is the bottom row of the picture. Channels are read as linear values in [0, 1].
+// One level of a mip chain: its size and where its texels start (in texels).
+struct MipLevel {
+  int width = 0;
+  int height = 0;
+  size_t offset = 0;
+};
+
+// log2(x) for x > 0 to within 3e-5, with float operations only (so that the scalar and the wide
+// samplers compute the same level of detail bit for bit): exponent plus a degree-5 polynomial
+// (least-squares fit of log2(1 + t) on [0, 1]) of the mantissa.
+inline float fast_log2(float x) {
+  uint32_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  float exponent = float(int32_t(bits >> 23) - 127);
+  bits = (bits & 0x007fffffu) | 0x3f800000u;
+  float m;
+  std::memcpy(&m, &bits, sizeof m);
+  float t = m - 1.0f;
+  float p = t * (1.44182512f + t * (-0.708674935f + t * (0.415397767f + t * (-0.194390433f +
+                                                                              t * 0.0458707517f))));
+  return exponent + p;
+}
+
+// An RGBA8 texture with its mip chain. Texel (i, j) has its centre at ((i + 0.5) / width,
+// (j + 0.5) / height) in (u, v); j = 0 is the bottom row of the picture. Channels are read as
+// linear values in [0, 1].
 class Texture {
  public:
   Texture() = default;
@@ -44,23 +72,60 @@ class Texture {
   }
 
   // Samples at (u, v) with the sampler's filter and wrap modes. An empty texture samples as
-  // opaque white, so a shader never has to test for a missing map.
+  // opaque white, so a shader never has to test for a missing map. Without derivatives,
+  // kTrilinear samples the base level (bilinear).
   glm::vec4 sample(const Sampler& s, glm::vec2 uv) const {
     if (texels_.empty()) return glm::vec4(1.0f);
-    if (s.filter == Filter::kNearest) return sample_nearest(s, uv);
-    return sample_bilinear(s, uv);
+    if (s.filter == Filter::kNearest) return sample_nearest(s, uv, 0);
+    return sample_bilinear(s, uv, 0);
   }
+  // The same with the change of (u, v) to the next pixel right (duv_dx) and down (duv_dy), which
+  // choose the mip level for kTrilinear (OpenGL's level of detail: log2 of the longer of the two
+  // derivative vectors in texels of the base level).
+  glm::vec4 sample(const Sampler& s, glm::vec2 uv, glm::vec2 duv_dx, glm::vec2 duv_dy) const {
+    if (texels_.empty() || s.filter != Filter::kTrilinear) return sample(s, uv);
+    float lod = level_of_detail(duv_dx, duv_dy);
+    if (!(lod > 0.0f)) return sample_bilinear(s, uv, 0);  // magnification (and NaN)
+    float top = float(levels() - 1);
+    float d = lod < top ? lod : top;
+    int l0 = int(d);
+    float t = d - float(l0);
+    glm::vec4 a = sample_bilinear(s, uv, l0);
+    if (l0 + 1 >= levels()) return a;
+    glm::vec4 b = sample_bilinear(s, uv, l0 + 1);
+    return a * (1.0f - t) + b * t;
+  }
+  float level_of_detail(glm::vec2 duv_dx, glm::vec2 duv_dy) const {
+    float w = float(width_), h = float(height_);
+    float xx = duv_dx.x * w, xy = duv_dx.y * h, yx = duv_dy.x * w, yy = duv_dy.y * h;
+    float rho2 = std::max(xx * xx + xy * xy, yx * yx + yy * yy);
+    return 0.5f * fast_log2(rho2);  // log2(sqrt(rho2)) without the root
+  }
+
+  // The mip chain: level 0 is the image, each next level half the size (rounded down, at least
+  // 1), down to 1x1; built once by 2x2 box filtering.
+  int levels() const { return int(levels_.size()); }
+  const MipLevel& level(int k) const { return levels_[size_t(k)]; }
 
   // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
   static int wrap(Wrap mode, int i, int size);
 
  private:
-  glm::vec4 sample_nearest(const Sampler& s, glm::vec2 uv) const;
-  glm::vec4 sample_bilinear(const Sampler& s, glm::vec2 uv) const;
+  glm::vec4 sample_nearest(const Sampler& s, glm::vec2 uv, int level) const;
+  glm::vec4 sample_bilinear(const Sampler& s, glm::vec2 uv, int level) const;
+  glm::vec4 level_texel(const MipLevel& l, int i, int j) const {
+    const uint8_t* t = &texels_[(l.offset + size_t(j) * size_t(l.width) + size_t(i)) * 4];
+    constexpr float k = 1.0f / 255.0f;
+    return {t[0] * k, t[1] * k, t[2] * k, t[3] * k};
+  }
+
+  static std::vector<MipLevel> mip_levels(int width, int height);
+  void downsample(const MipLevel& from, const MipLevel& to);
 
   int width_ = 0;
   int height_ = 0;
-  std::vector<uint8_t> texels_;  // rows bottom-up, RGBA8
+  std::vector<uint8_t> texels_;  // every level, rows bottom-up, RGBA8
+  std::vector<MipLevel> levels_;
 };
 
 // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
@@ -97,23 +162,25 @@ inline int texel_floor(float x, float& fraction) {
   return i;
 }
 
-inline glm::vec4 Texture::sample_nearest(const Sampler& s, glm::vec2 uv) const {
+inline glm::vec4 Texture::sample_nearest(const Sampler& s, glm::vec2 uv, int level) const {
+  const MipLevel& l = levels_[size_t(level)];
   float unused;
-  int i = wrap(s.wrap_u, texel_floor(uv.x * float(width_), unused), width_);
-  int j = wrap(s.wrap_v, texel_floor(uv.y * float(height_), unused), height_);
-  return texel(i, j);
+  int i = wrap(s.wrap_u, texel_floor(uv.x * float(l.width), unused), l.width);
+  int j = wrap(s.wrap_v, texel_floor(uv.y * float(l.height), unused), l.height);
+  return level_texel(l, i, j);
 }
 
-inline glm::vec4 Texture::sample_bilinear(const Sampler& s, glm::vec2 uv) const {
+inline glm::vec4 Texture::sample_bilinear(const Sampler& s, glm::vec2 uv, int level) const {
   // Texel centres sit at half-integers, so shift by half a texel before splitting into the
   // integer texel and the fractional weight (GL_LINEAR).
+  const MipLevel& l = levels_[size_t(level)];
   float fx, fy;
-  int x0 = texel_floor(uv.x * float(width_) - 0.5f, fx);
-  int y0 = texel_floor(uv.y * float(height_) - 0.5f, fy);
-  int i0 = wrap(s.wrap_u, x0, width_), i1 = wrap(s.wrap_u, x0 + 1, width_);
-  int j0 = wrap(s.wrap_v, y0, height_), j1 = wrap(s.wrap_v, y0 + 1, height_);
-  glm::vec4 bottom = texel(i0, j0) * (1.0f - fx) + texel(i1, j0) * fx;
-  glm::vec4 top = texel(i0, j1) * (1.0f - fx) + texel(i1, j1) * fx;
+  int x0 = texel_floor(uv.x * float(l.width) - 0.5f, fx);
+  int y0 = texel_floor(uv.y * float(l.height) - 0.5f, fy);
+  int i0 = wrap(s.wrap_u, x0, l.width), i1 = wrap(s.wrap_u, x0 + 1, l.width);
+  int j0 = wrap(s.wrap_v, y0, l.height), j1 = wrap(s.wrap_v, y0 + 1, l.height);
+  glm::vec4 bottom = level_texel(l, i0, j0) * (1.0f - fx) + level_texel(l, i1, j0) * fx;
+  glm::vec4 top = level_texel(l, i0, j1) * (1.0f - fx) + level_texel(l, i1, j1) * fx;
   return bottom * (1.0f - fy) + top * fy;
 }
 

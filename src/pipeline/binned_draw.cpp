@@ -1,41 +1,73 @@
-// pipeline/binned_draw.cpp: filled triangles on several threads, in two phases per batch.
-//   1. Geometry: the batch is cut into chunks of consecutive triangles; each chunk (one thread at
-//      a time) clips and sets up its triangles and appends each setup's index to the bin of
-//      every 64x64 tile its bounds touch.
+// pipeline/binned_draw.cpp: filled triangles binned into 64x64 tiles, on the calling thread alone
+// or on several.
+//   0. Vertices (in parallel): each vertex's outcode and, inside the clip volume, its snapped
+//      window position, once per vertex instead of once per triangle corner.
+//   1. Geometry, per batch of triangles: the batch is cut into chunks of consecutive triangles;
+//      each chunk (one thread at a time) trivially accepts triangles whose three vertices are
+//      inside the clip volume (guard band, near, far) and clips the others, culls by the snapped
+//      area, sets up a compact record (triangle_record.hpp) in the chunk's arena and appends its
+//      offset to the bin of every tile its bounds touch.
 //   2. Raster: each tile (one thread at a time) walks the bins of all chunks in chunk order, so
 //      every pixel sees its triangles in submission order and blending stays order-correct; the
-//      tile is the raster region, so no two threads ever touch the same pixel.
-// The image equals the single-threaded path's bit for bit: setup is the same function, and the
-// rasterizers give the same coverage whatever region a triangle is cut into.
+//      tile is the raster region, so no two threads ever touch the same pixel. Deferrable draws
+//      resolve the tile's visibility first and shade each visible pixel once (tile_visibility.hpp).
+// The image equals the reference path's bit for bit: setup is the same code, the window vertices
+// the same function of the clip vertex, the tile kernels' coverage that of the edge-equation
+// rasterizer, and the depth resolve the fragment stage's arithmetic.
+//
+// Memory: the per-vertex arrays, the arenas and the bins live in a cache of the calling thread
+// and keep their capacity, so after the first frame of a scene a draw allocates nothing. Bins
+// hold offsets into their chunk's arena rather than copies of the records: a triangle touching
+// many tiles is stored once, and a tile still reads each chunk's records in increasing address
+// order.
 #include <algorithm>
+#include <atomic>
 #include <memory>
+#include <new>
 #include <vector>
 
 #include "pipeline/draw_internal.hpp"
+#include "pipeline/tile_kernels.hpp"
 #include "pipeline/tile_visibility.hpp"
+#include "pipeline/triangle_record.hpp"
 #include "softrast/detail/parallel.hpp"
 
 namespace softrast::detail {
 namespace {
 
-// Triangles per batch: bounds the setups held at once (a setup is about 350 bytes).
-constexpr size_t kBatchTriangles = 16384;
+// Triangles per batch: bounds the records held at once (about 200 bytes each for 3 varyings).
+constexpr size_t kBatchTriangles = 32768;
 // Chunks per thread in the geometry phase, for load balance when clipping is uneven.
 constexpr int kChunksPerThread = 4;
+constexpr size_t kVerticesPerJob = 8192;
 
-// A thread's scratch for deferred tiles, allocated once per thread and reused by every draw.
+// Cache-line aligned: each chunk's arena and bins are written by one thread while neighbours are
+// written by others.
+struct alignas(64) Chunk {
+  RecordArena records;
+  std::vector<std::vector<uint32_t>> bins;  // per tile: offsets of its records in `records`
+};
+
+// A tile worker's scratch for deferred tiles.
 struct DeferredScratch {
   TileVisibility visibility;
   std::vector<const Interpolants*> interps;  // by id: the tile's triangles in submission order
 };
 
-DeferredScratch& deferred_scratch() {
-  thread_local std::unique_ptr<DeferredScratch> scratch;
-  if (!scratch) scratch = std::make_unique<DeferredScratch>();
-  return *scratch;
+// What a draw reuses from the previous draw on the same thread.
+struct DrawCache {
+  std::vector<PackedVertex> window;
+  std::vector<uint8_t> codes;  // GeometryStage::vertex_code
+  std::vector<Chunk> chunks;
+  std::vector<std::unique_ptr<DeferredScratch>> scratch;  // per tile worker
+};
+
+DrawCache& draw_cache() {
+  thread_local DrawCache cache;
+  return cache;
 }
 
-// The rasterizer's blocks of one triangle into the tile's depth resolve.
+// The scanline rasterizer's blocks of one triangle into the tile's depth resolve.
 struct ResolveSink {
   TileVisibility* visibility;
   ResolveBlockFn kernel;
@@ -51,68 +83,110 @@ struct ResolveSink {
   }
 };
 
-struct Chunk {
-  std::vector<TriangleSetup> setups;
-  std::vector<std::vector<uint32_t>> bins;  // per tile: indices into setups
-};
-
 class BinnedDraw {
  public:
   BinnedDraw(const GeometryStage& geometry, const RenderState& state, const ShadeTarget& target,
              const FragmentProgram& program, int threads)
-      : geometry_(geometry), state_(state), target_(target), program_(program), threads_(threads) {
+      : geometry_(geometry),
+        state_(state),
+        target_(target),
+        program_(program),
+        threads_(threads),
+        cache_(draw_cache()) {
     deferred_ = deferred_shading_applies(state, program);
-    if (deferred_) resolve_kernel_ = resolve_block_kernel();
+    kernels_ = tile_kernels(simd_level());
+    record_bytes_ = record_bytes(geometry.num_varyings());
     const PixelRect& s = geometry.scissor();
     tiles_x_ = (s.x1 + kTileSize - 1) / kTileSize;
     tiles_y_ = (s.y1 + kTileSize - 1) / kTileSize;
-    chunks_.resize(size_t(threads) * kChunksPerThread);
-    for (Chunk& c : chunks_) c.bins.resize(size_t(tiles_x_) * size_t(tiles_y_));
+    cache_.chunks.resize(threads == 1 ? 1 : size_t(threads) * kChunksPerThread);
+    for (Chunk& c : cache_.chunks) c.bins.resize(size_t(tiles_x_) * size_t(tiles_y_));
   }
 
   void draw(const uint32_t* indices, size_t index_count) {
+    transform_vertices();
+    std::vector<Chunk>& chunks = cache_.chunks;
     size_t triangles = index_count / 3;
     for (size_t first = 0; first < triangles; first += kBatchTriangles) {
       size_t count = std::min(kBatchTriangles, triangles - first);
-      size_t per_chunk = (count + chunks_.size() - 1) / chunks_.size();
-      parallel_for(chunks_.size(), threads_, [&](size_t c) {
-        size_t begin = first + c * per_chunk;
+      size_t per_chunk = (count + chunks.size() - 1) / chunks.size();
+      parallel_for(chunks.size(), threads_, [&](size_t c) {
+        size_t begin = std::min(first + count, first + c * per_chunk);
         size_t end = std::min(first + count, begin + per_chunk);
-        setup_chunk(chunks_[c], indices, begin, end);
+        setup_chunk(chunks[c], indices, begin, end);
       });
-      parallel_for(size_t(tiles_x_) * size_t(tiles_y_), threads_, [&](size_t tile) {
-        deferred_ ? resolve_and_shade_tile(tile) : raster_tile(tile);
-      });
+      raster_tiles();
     }
   }
 
  private:
+  // Phase 0: outcodes and window positions, once per vertex, several at a time.
+  void transform_vertices() {
+    size_t n = geometry_.vertex_count();
+    cache_.window.resize(n);
+    cache_.codes.resize(n);
+    VertexBatch batch = geometry_.vertex_batch(cache_.codes.data(), cache_.window.data());
+    VertexKernelFn kernel = vertex_kernel(simd_level());
+    size_t jobs = (n + kVerticesPerJob - 1) / kVerticesPerJob;
+    parallel_for(jobs, threads_, [&](size_t job) {
+      kernel(batch, job * kVerticesPerJob, std::min(n, (job + 1) * kVerticesPerJob));
+    });
+  }
+
+  WindowVertex window_vertex(uint32_t i) const {
+    const PackedVertex& p = cache_.window[i];
+    return {p.x, p.y, p.z, p.inv_w, geometry_.varyings(i)};
+  }
+
+  // Phase 1 for one chunk.
   void setup_chunk(Chunk& chunk, const uint32_t* indices, size_t begin, size_t end) {
-    chunk.setups.clear();
+    chunk.records.clear();
     for (std::vector<uint32_t>& bin : chunk.bins) bin.clear();
-    auto on_triangle = [&](const WindowVertex& a, const WindowVertex& b, const WindowVertex& c) {
-      chunk.setups.emplace_back();
-      TriangleSetup& tri = chunk.setups.back();
-      if (!setup_triangle(a, b, c, geometry_.num_varyings(), state_.cull, state_.front_face,
-                          geometry_.scissor(), tri)) {
-        chunk.setups.pop_back();
-        return;
-      }
-      bin(chunk, tri.bounds, uint32_t(chunk.setups.size() - 1));
+    auto add = [&](const WindowVertex& a, const WindowVertex& b, const WindowVertex& c) {
+      add_triangle(chunk, a, b, c);
     };
+    static_assert(GeometryStage::kNonFinite < 256, "codes are stored in bytes");
+    const uint8_t* codes = cache_.codes.data();
     for (size_t t = begin; t < end; ++t) {
       const uint32_t* i = indices + 3 * t;
-      if (geometry_.valid(i[0]) && geometry_.valid(i[1]) && geometry_.valid(i[2])) {
-        geometry_.triangle(i[0], i[1], i[2], on_triangle);
+      if (!geometry_.valid(i[0]) || !geometry_.valid(i[1]) || !geometry_.valid(i[2])) continue;
+      uint32_t c0 = codes[i[0]], c1 = codes[i[1]], c2 = codes[i[2]];
+      if ((c0 | c1 | c2) == 0) {  // trivially accepted: no clipping, vertices already in window
+        add_triangle(chunk, window_vertex(i[0]), window_vertex(i[1]), window_vertex(i[2]));
+      } else if (!((c0 | c1 | c2) & GeometryStage::kNonFinite) && !(c0 & c1 & c2)) {
+        geometry_.triangle(i[0], i[1], i[2], add);  // crosses a plane: clip
       }
     }
   }
 
-  void bin(Chunk& chunk, const PixelRect& bounds, uint32_t id) {
+  void add_triangle(Chunk& chunk, const WindowVertex& a, const WindowVertex& b,
+                    const WindowVertex& c) {
+    // Culling first: half of a closed mesh stops here, before any other work.
+    int64_t area = signed_area_fx16(a, b, c);
+    if (area == 0 || is_culled(area, state_.cull, state_.front_face)) return;
+    uint32_t offset = chunk.records.allocate(record_bytes_);
+    TriRecord* rec = new (chunk.records.at(offset)) TriRecord;
+    const WindowVertex* ordered[3];
+    if (!setup_triangle_coverage(a, b, c, state_.cull, state_.front_face, geometry_.scissor(),
+                                 rec->coverage, ordered, area)) {
+      chunk.records.release_last(record_bytes_);
+      return;
+    }
+    const TriangleCoverage& t = rec->coverage;
+    auto extent = [](const int32_t v[3]) {
+      return int64_t(std::max({v[0], v[1], v[2]})) - std::min({v[0], v[1], v[2]});
+    };
+    rec->small = extent(t.vx) <= kSmallTriangleFx8 && extent(t.vy) <= kSmallTriangleFx8;
+    setup_triangle_interpolants(ordered, geometry_.num_varyings(), area, state_.front_face,
+                                rec->interp());
+    bin(chunk, t.bounds, offset);
+  }
+
+  void bin(Chunk& chunk, const PixelRect& bounds, uint32_t offset) {
     int tx0 = bounds.x0 / kTileSize, tx1 = (bounds.x1 - 1) / kTileSize;
     int ty0 = bounds.y0 / kTileSize, ty1 = (bounds.y1 - 1) / kTileSize;
     for (int ty = ty0; ty <= ty1; ++ty) {
-      for (int tx = tx0; tx <= tx1; ++tx) chunk.bins[size_t(ty) * tiles_x_ + tx].push_back(id);
+      for (int tx = tx0; tx <= tx1; ++tx) chunk.bins[size_t(ty) * tiles_x_ + tx].push_back(offset);
     }
   }
 
@@ -122,34 +196,80 @@ class BinnedDraw {
     return intersect(region, geometry_.scissor());
   }
 
-  // Immediate shading: every block of every triangle goes to the fragment stage as it comes.
+  // Phase 2: tile workers take tiles in increasing order until none is left. Each worker has its
+  // own scratch in the cache (not one per thread), so what is allocated does not depend on which
+  // thread ran which tile.
+  void raster_tiles() {
+    size_t tiles = size_t(tiles_x_) * size_t(tiles_y_);
+    size_t workers = std::min<size_t>(size_t(threads_), tiles);
+    if (deferred_) {
+      size_t records = 0;  // a tile holds at most every record of the batch once
+      for (const Chunk& c : cache_.chunks) records += c.records.used() / record_bytes_;
+      if (cache_.scratch.size() < workers) cache_.scratch.resize(workers);
+      for (size_t w = 0; w < workers; ++w) {
+        if (!cache_.scratch[w]) cache_.scratch[w] = std::make_unique<DeferredScratch>();
+        if (cache_.scratch[w]->interps.size() < records) cache_.scratch[w]->interps.resize(records);
+      }
+    }
+    std::atomic<size_t> next{0};
+    parallel_for(workers, threads_, [&](size_t worker) {
+      for (size_t tile = next.fetch_add(1); tile < tiles; tile = next.fetch_add(1)) {
+        deferred_ ? resolve_and_shade_tile(tile, *cache_.scratch[worker]) : raster_tile(tile);
+      }
+    });
+  }
+
+  // Phase 2, immediate shading: every block of every triangle goes to the fragment stage as it
+  // is rasterized.
   void raster_tile(size_t tile) {
-    PixelRect region = tile_region(tile);
+    TileJob job;
+    job.region = tile_region(tile);
+    job.program = &program_;
+    job.target = &target_;
     Shading shading(program_, target_);
-    for (const Chunk& chunk : chunks_) {
-      for (uint32_t id : chunk.bins[tile]) {
-        const TriangleSetup& tri = chunk.setups[id];
-        rasterize_triangle(tri, state_.raster, region, shading.sink(tri.interp));
+    for (const Chunk& chunk : cache_.chunks) {
+      const std::vector<uint32_t>& bin = chunk.bins[tile];
+      if (bin.empty()) continue;
+      if (state_.raster == RasterAlgorithm::kEdgeEquations) {
+        kernels_.immediate(job, chunk.records.data(), bin.data(), bin.size());
+        continue;
+      }
+      for (uint32_t offset : bin) {
+        const TriRecord& rec = record(chunk, offset);
+        rasterize_triangle_scanline(rec.coverage, job.region, shading.sink(rec.interp()));
       }
     }
   }
 
-  // Deferred shading (tile_visibility.hpp): visibility of all the tile's triangles first, in
-  // submission order, then one shading call per block and winning triangle.
-  void resolve_and_shade_tile(size_t tile) {
-    PixelRect region = tile_region(tile);
-    DeferredScratch& scratch = deferred_scratch();
+  // Phase 2, deferred shading (tile_visibility.hpp): visibility of all the tile's triangles
+  // first, in submission order, then one shading call per block and winning triangle.
+  void resolve_and_shade_tile(size_t tile, DeferredScratch& scratch) {
+    bool any = false;
+    for (const Chunk& chunk : cache_.chunks) any |= !chunk.bins[tile].empty();
+    if (!any) return;
     TileVisibility& visibility = scratch.visibility;
-    visibility.begin(*target_.framebuffer, region);
-    scratch.interps.clear();
-    ResolveSink sink{&visibility, resolve_kernel_, state_.depth_func == DepthFunc::kLessEqual, {}, 0};
-    for (const Chunk& chunk : chunks_) {
-      for (uint32_t id : chunk.bins[tile]) {
-        const TriangleSetup& tri = chunk.setups[id];
-        sink.plane = {tri.interp.x_ref, tri.interp.y_ref, tri.interp.z};
-        sink.id = int32_t(scratch.interps.size());
-        scratch.interps.push_back(&tri.interp);
-        rasterize_triangle(tri, state_.raster, region, BlockSink{&ResolveSink::emit, &sink});
+    TileJob job;
+    job.region = tile_region(tile);
+    job.visibility = &visibility;
+    job.less_equal = state_.depth_func == DepthFunc::kLessEqual;
+    job.interps = scratch.interps.data();
+    visibility.begin(*target_.framebuffer, job.region);
+    for (const Chunk& chunk : cache_.chunks) {
+      const std::vector<uint32_t>& bin = chunk.bins[tile];
+      if (bin.empty()) continue;
+      if (state_.raster == RasterAlgorithm::kEdgeEquations) {
+        kernels_.deferred(job, chunk.records.data(), bin.data(), bin.size());
+        continue;
+      }
+      ResolveSink sink{&visibility, kernels_.resolve_block, job.less_equal, {}, 0};
+      for (uint32_t offset : bin) {
+        const TriRecord& rec = record(chunk, offset);
+        const Interpolants& in = rec.interp();
+        sink.plane = {in.x_ref, in.y_ref, in.z};
+        sink.id = job.next_id++;
+        job.interps[sink.id] = &in;
+        rasterize_triangle_scanline(rec.coverage, job.region,
+                                    BlockSink{&ResolveSink::emit, &sink});
       }
     }
     visibility.store_depth();
@@ -159,15 +279,20 @@ class BinnedDraw {
     visibility.reset();
   }
 
+  static const TriRecord& record(const Chunk& chunk, uint32_t offset) {
+    return *reinterpret_cast<const TriRecord*>(chunk.records.data() + offset);
+  }
+
   const GeometryStage& geometry_;
   const RenderState& state_;
-  bool deferred_ = false;
-  ResolveBlockFn resolve_kernel_ = nullptr;
   ShadeTarget target_;
   const FragmentProgram& program_;
   int threads_;
+  DrawCache& cache_;
+  bool deferred_ = false;
+  TileKernels kernels_{};
+  size_t record_bytes_ = 0;
   int tiles_x_ = 0, tiles_y_ = 0;
-  std::vector<Chunk> chunks_;
 };
 
 }  // namespace

@@ -28,7 +28,7 @@ class Shading {
   const Interpolants* current_ = nullptr;
 };
 
-inline void rasterize_triangle(const TriangleSetup& tri, RasterAlgorithm algorithm,
+inline void rasterize_triangle(const TriangleCoverage& tri, RasterAlgorithm algorithm,
                                const PixelRect& region, const BlockSink& sink) {
   if (algorithm == RasterAlgorithm::kScanline) {
     rasterize_triangle_scanline(tri, region, sink);

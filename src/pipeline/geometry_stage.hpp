@@ -9,6 +9,7 @@
 
 #include "geometry/clip.hpp"
 #include "geometry/viewport.hpp"
+#include "pipeline/vertex_kernels.hpp"
 #include "raster/setup.hpp"
 #include "softrast/render_state.hpp"
 
@@ -28,6 +29,7 @@ class GeometryStage {
   const PixelRect& scissor() const { return scissor_; }
   int num_varyings() const { return vertices_.num_varyings; }
   bool valid(uint32_t index) const { return size_t(index) < vertices_.count; }
+  size_t vertex_count() const { return vertices_.count; }
 
   // Calls emit(w0, w1, w2) for every window-space triangle that triangle (i0, i1, i2) clips to,
   // in order (a clipped polygon becomes a fan). Precondition: valid indices.
@@ -64,6 +66,31 @@ class GeometryStage {
     load(i1, b);
     if (!clip_line(a, b, num_floats_, volume_, ca, cb)) return;
     emit(window(ca.v), window(cb.v));
+  }
+
+  // Per-vertex front end, for producers that transform each vertex once (the binned draw):
+  // vertex i's outcode (clip_outcode), or kNonFinite when its position has a NaN or an Inf.
+  static constexpr uint32_t kNonFinite = 1u << kNumClipPlanes;
+  uint32_t vertex_code(uint32_t i) const {
+    const float* p = vertex(i);
+    return is_finite_position(p) ? clip_outcode(p, volume_) : kNonFinite;
+  }
+  // Vertex i in window space, exactly as triangle() makes it; precondition: vertex_code(i) == 0.
+  WindowVertex window_vertex(uint32_t i) const { return window(vertex(i)); }
+  const float* varyings(uint32_t i) const { return vertex(i) + 4; }
+  // The same for many vertices at once (vertex_kernels.hpp), writing to `codes` and `window`.
+  VertexBatch vertex_batch(uint8_t* codes, PackedVertex* window) const {
+    VertexBatch b;
+    b.data = vertices_.data;
+    b.stride = vertices_.stride;
+    b.guard_x = volume_.guard_x;
+    b.guard_y = volume_.guard_y;
+    b.width = viewport_.width;
+    b.height = viewport_.height;
+    b.depth_bias = state_.depth_bias;
+    b.codes = codes;
+    b.window = window;
+    return b;
   }
 
   // The window position of point i; false when it lies outside the clip volume.

@@ -1,12 +1,12 @@
-// pipeline/tile_visibility.cpp: the tile's depth and id scratch, the depth-resolve kernels (one
-// source, compiled for SSE2, AVX2 and AVX-512, picked at run time) and the shading of winners.
+// pipeline/tile_visibility.cpp: the tile's depth and id scratch and the shading of winners (the
+// resolve kernels are in tile_kernel.inl).
 #include "pipeline/tile_visibility.hpp"
+
+#include <emmintrin.h>
 
 #include <algorithm>
 #include <cstring>
 
-#include "softrast/simd.hpp"
-#include "softrast/simd_level.hpp"
 
 namespace softrast::detail {
 
@@ -26,6 +26,12 @@ void TileVisibility::load_block(int b) {
   int x0 = region.x0 + (b % kBlocksPerRow) * kBlockSize;
   int y0 = region.y0 + (b / kBlocksPerRow) * kBlockSize;
   int cols = std::min(kBlockSize, region.x1 - x0), rows = std::min(kBlockSize, region.y1 - y0);
+  if (cols == kBlockSize) {  // a constant size: four inlined 16-byte copies
+    for (int r = 0; r < rows; ++r) {
+      std::memcpy(&depth[b][4 * r], framebuffer->depth_row(y0 + r) + x0, sizeof(float) * 4);
+    }
+    return;
+  }
   for (int r = 0; r < rows; ++r) {
     std::memcpy(&depth[b][4 * r], framebuffer->depth_row(y0 + r) + x0, sizeof(float) * cols);
   }
@@ -39,7 +45,12 @@ void TileVisibility::store_depth() const {
       int y0 = region.y0 + (b / kBlocksPerRow) * kBlockSize;
       int cols = std::min(kBlockSize, region.x1 - x0), rows = std::min(kBlockSize, region.y1 - y0);
       for (int r = 0; r < rows; ++r) {
-        std::memcpy(framebuffer->depth_row(y0 + r) + x0, &depth[b][4 * r], sizeof(float) * cols);
+        float* row = framebuffer->depth_row(y0 + r) + x0;
+        if (cols == kBlockSize) {
+          std::memcpy(row, &depth[b][4 * r], sizeof(float) * 4);
+        } else {
+          std::memcpy(row, &depth[b][4 * r], sizeof(float) * cols);
+        }
       }
     }
   }
@@ -57,56 +68,18 @@ void TileVisibility::reset() {
 
 namespace {
 
-// The kernel body, written once on the wide types of softrast/simd.hpp (16 lanes, N per native
-// vector; lane l = 4 * row + column) and inlined into one wrapper per instruction set. simd.hpp
-// routes AVX-512 comparisons and selects through intrinsics: GCC 12 splits the plain vector-
-// extension forms into lanes there, which made this kernel 3x slower than its AVX2 twin.
-template <int N, bool kLessEqual>
-[[gnu::always_inline]] inline void resolve_block_body(const DepthPlaneRef& p, int x, int y,
-                                                      uint32_t mask, int32_t id, float* depth,
-                                                      int32_t* ids) {
-  using F = simd::Float<N>;
-  using I = simd::Int<N>;
-  // Exactly the fragment stage's depth: dx = float(px) + 0.5 - x_ref, then
-  // z = clamp((a0 + dadx * dx) + dady * dy, 0, 1) with std::clamp's NaN and -0 behaviour.
-  F dx = (simd::to_float(I(x) + simd::lane_column<N>()) + F(0.5f)) - F(p.x_ref);
-  F dy = (simd::to_float(I(y) + simd::lane_row<N>()) + F(0.5f)) - F(p.y_ref);
-  F z = (F(p.z.a0) + F(p.z.dadx) * dx) + F(p.z.dady) * dy;
-  z = simd::clamp(z, F(0.0f), F(1.0f));
-  F stored = F::load(depth);
-  I winner = I::load(ids);
-  I pass = (kLessEqual ? (z <= stored) : (z < stored)) & simd::lanes_of<N>(mask);
-  simd::select(pass, z, stored).store(depth);
-  simd::select(pass, I(id), winner).store(ids);
-}
-
-#define SOFTRAST_RESOLVE_KERNEL(name, lanes, target_attr)                                     \
-  target_attr [[gnu::flatten]] void name(const DepthPlaneRef& p, int x, int y, uint32_t mask, int32_t id,       \
-                        bool less_equal, float* depth, int32_t* ids) {                         \
-    if (less_equal) {                                                                          \
-      resolve_block_body<lanes, true>(p, x, y, mask, id, depth, ids);                          \
-    } else {                                                                                   \
-      resolve_block_body<lanes, false>(p, x, y, mask, id, depth, ids);                         \
-    }                                                                                          \
+// Bit l set where ids[l] == value, for the 16 ids of a block (SSE2, the x86-64 baseline).
+uint32_t lanes_equal(const int32_t* ids, int32_t value) {
+  __m128i v = _mm_set1_epi32(value);
+  uint32_t bits = 0;
+  for (int q = 0; q < 4; ++q) {
+    __m128i four = _mm_load_si128(reinterpret_cast<const __m128i*>(ids + 4 * q));
+    bits |= uint32_t(_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(four, v)))) << (4 * q);
   }
-SOFTRAST_RESOLVE_KERNEL(resolve_block_sse2, 4, )
-SOFTRAST_RESOLVE_KERNEL(resolve_block_avx2, 8, __attribute__((target("avx2"))))
-SOFTRAST_RESOLVE_KERNEL(resolve_block_avx512, 16,
-                        __attribute__((target("avx512f,avx512bw,avx512dq,avx512vl"))))
-#undef SOFTRAST_RESOLVE_KERNEL
+  return bits;
+}
 
 }  // namespace
-
-ResolveBlockFn resolve_block_kernel() {
-  switch (simd_level()) {
-    case SimdLevel::kAvx512:
-      return &resolve_block_avx512;
-    case SimdLevel::kAvx2:
-      return &resolve_block_avx2;
-    default:
-      return &resolve_block_sse2;
-  }
-}
 
 void shade_winners(const TileVisibility& vis, const Interpolants* const* interps,
                    const FragmentProgram& program, const ShadeTarget& resolved_target) {
@@ -115,15 +88,13 @@ void shade_winners(const TileVisibility& vis, const Interpolants* const* interps
     for (uint64_t bits = vis.touched[word]; bits != 0; bits &= bits - 1) {
       int b = word * 64 + __builtin_ctzll(bits);
       const int32_t* ids = vis.id[b];
-      uint32_t left = 0;
-      for (int l = 0; l < 16; ++l) left |= uint32_t(ids[l] != TileVisibility::kNoWinner) << l;
+      uint32_t left = ~lanes_equal(ids, TileVisibility::kNoWinner) & 0xffffu;
       int x = vis.region.x0 + (b % kPerRow) * kBlockSize;
       int y = vis.region.y0 + (b / kPerRow) * kBlockSize;
       // One call per distinct winner of the block, with exactly the pixels it won.
       while (left != 0) {
         int32_t winner = ids[__builtin_ctz(left)];
-        uint32_t mask = 0;
-        for (int l = 0; l < 16; ++l) mask |= uint32_t(ids[l] == winner) << l;
+        uint32_t mask = lanes_equal(ids, winner);
         left &= ~mask;
         program.shade_block(program.shader, resolved_target, *interps[winner], x, y, mask);
       }

@@ -67,7 +67,7 @@ struct DepthPlaneRef {
 
 // Depth-tests the pixels of `mask` in the 4x4 block at pixel (x, y) of the tile against the
 // tile's depth (LESS, or LEQUAL when `less_equal`), and where the test passes writes the
-// fragment's depth and `id`. Picks the widest SIMD kernel of simd_level() once per draw.
+// fragment's depth and `id`. resolve_block_kernel() picks the widest kernel simd_level() allows.
 using ResolveBlockFn = void (*)(const DepthPlaneRef& plane, int x, int y, uint32_t mask,
                                 int32_t id, bool less_equal, float* depth, int32_t* ids);
 ResolveBlockFn resolve_block_kernel();

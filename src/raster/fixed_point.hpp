@@ -27,6 +27,20 @@ inline constexpr int64_t kMaxCoordFx8 = int64_t(1) << (15 + kSubpixelBits);  // 
 static_assert(kMaxCoordFx8 == (int64_t(1) << 23));
 static_assert((2 * kMaxCoordFx8) * kMaxCoordFx8 * 4 < (int64_t(1) << 62),
               "edge functions overflow");
+// The 32-bit coverage fast path. A triangle whose vertices span at most kSmallTriangleFx8 in x
+// and in y (64 pixels) has every edge function value at every sample of a 4x4 block that
+// overlaps its pixel bounds within int32. With (xi, yi) either vertex of the edge,
+//   E(p) = a (px - xi) + b (py - yi) (- 1 for the fill-rule bias), |a| = |dy| <= H, |b| = |dx| <= W
+// where W, H <= S = kSmallTriangleFx8 are the vertex extents; a block overlapping the bounds has
+// its samples within 3 pixels (768) of the extents, so |px - xi| < W + 4 * 256 and likewise y:
+//   |E| < 2 S (S + 1024) + 1 = 2^29 + 2^25 + 1 < 2^31.
+// The per-pixel offsets inside a block, |a| * 3 * 256 + |b| * 3 * 256 < 2^25, fit as well.
+// Larger triangles take the exact int64 path.
+inline constexpr int64_t kSmallTriangleFx8 = int64_t(1) << 14;
+static_assert(2 * kSmallTriangleFx8 * (kSmallTriangleFx8 + 4 * kSubpixelOne) + 1 <
+                  (int64_t(1) << 31),
+              "32-bit edge functions overflow");
+
 // The largest image must fit well inside the guard band (the band is at least 1.9 images wide on
 // each side of the largest image, and far wider for usual sizes).
 static_assert(kMaxImageSize * 19 / 10 <= kGuardBandPixels, "guard band narrower than the image");

@@ -26,11 +26,11 @@ struct BlockSink {
 // three edge functions, restricted to `region` (a rectangle whose origin is a multiple of 4;
 // pass the scissor, or one tile). Blocks are emitted in a rasterizer-specific order.
 // (a) Edge equations: hierarchical half-space tests over 64x64 tiles, 16x16 and 4x4 blocks.
-void rasterize_triangle_edge_equations(const TriangleSetup& tri, const PixelRect& region,
+void rasterize_triangle_edge_equations(const TriangleCoverage& tri, const PixelRect& region,
                                        const BlockSink& sink);
 // (b) Edge walking: the triangle split at its middle vertex into two trapezoids, each walked
 // scanline by scanline along its left and right edges.
-void rasterize_triangle_scanline(const TriangleSetup& tri, const PixelRect& region,
+void rasterize_triangle_scanline(const TriangleCoverage& tri, const PixelRect& region,
                                  const BlockSink& sink);
 
 // Lines by OpenGL's diamond-exit rule (with its endpoint perturbation deciding ties): the pixels

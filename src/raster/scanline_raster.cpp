@@ -94,7 +94,7 @@ int first_row_at_or_below(int64_t y_fx8) {
 
 }  // namespace
 
-void rasterize_triangle_scanline(const TriangleSetup& tri, const PixelRect& region,
+void rasterize_triangle_scanline(const TriangleCoverage& tri, const PixelRect& region,
                                  const BlockSink& sink) {
   PixelRect area = intersect(tri.bounds, region);
   if (area.empty()) return;

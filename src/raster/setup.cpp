@@ -33,16 +33,21 @@ double to_pixels(int32_t fx8) {
   return double(fx8) / kSubpixelOne;
 }
 
-// The plane through (x_k, y_k, a_k), k = 0..2, referenced at vertex 0. `area2` is twice the
-// signed area in square pixels (non-zero).
-Plane make_plane(const double x[3], const double y[3], const double a[3], double area2) {
-  double da1 = a[1] - a[0], da2 = a[2] - a[0];
-  double dx1 = x[1] - x[0], dx2 = x[2] - x[0];
-  double dy1 = y[1] - y[0], dy2 = y[2] - y[0];
+// The triangle's shape as the plane equations need it: vertex 1 and 2 minus vertex 0, in pixels,
+// and the reciprocal of twice the signed area in square pixels (one division per triangle, not
+// two per plane: the gradients are float in the end, and the product differs from the quotient by
+// at most an ulp of a double).
+struct PlaneBasis {
+  double dx1, dx2, dy1, dy2, inv_area2;
+};
+
+// The plane through the vertices with values a0, a1, a2, referenced at vertex 0.
+Plane make_plane(const PlaneBasis& g, double a0, double a1, double a2) {
+  double da1 = a1 - a0, da2 = a2 - a0;
   Plane p;
-  p.a0 = float(a[0]);
-  p.dadx = float((da1 * dy2 - da2 * dy1) / area2);
-  p.dady = float((da2 * dx1 - da1 * dx2) / area2);
+  p.a0 = float(a0);
+  p.dadx = float((da1 * g.dy2 - da2 * g.dy1) * g.inv_area2);
+  p.dady = float((da2 * g.dx1 - da1 * g.dx2) * g.inv_area2);
   return p;
 }
 
@@ -62,21 +67,21 @@ PixelRect triangle_bounds(const int32_t vx[3], const int32_t vy[3]) {
 // Fills the planes for depth, 1/w and varying/w of the (already reordered) triangle.
 void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area_fx16,
                   Interpolants& out) {
-  double x[3], y[3], a[3];
-  for (int k = 0; k < 3; ++k) {
-    x[k] = to_pixels(v[k]->x);
-    y[k] = to_pixels(v[k]->y);
-  }
-  double area2 = double(area_fx16) / (double(kSubpixelOne) * kSubpixelOne);
-  out.x_ref = float(x[0]);
-  out.y_ref = float(y[0]);
-  for (int k = 0; k < 3; ++k) a[k] = v[k]->z;
-  out.z = make_plane(x, y, a, area2);
-  for (int k = 0; k < 3; ++k) a[k] = v[k]->inv_w;
-  out.inv_w = make_plane(x, y, a, area2);
+  PlaneBasis g;
+  g.dx1 = to_pixels(v[1]->x - v[0]->x);  // differences of 16.8 coordinates: exact in int32
+  g.dx2 = to_pixels(v[2]->x - v[0]->x);
+  g.dy1 = to_pixels(v[1]->y - v[0]->y);
+  g.dy2 = to_pixels(v[2]->y - v[0]->y);
+  g.inv_area2 = double(kSubpixelOne) * kSubpixelOne / double(area_fx16);
+  out.x_ref = float(to_pixels(v[0]->x));
+  out.y_ref = float(to_pixels(v[0]->y));
+  out.z = make_plane(g, v[0]->z, v[1]->z, v[2]->z);
+  out.inv_w = make_plane(g, v[0]->inv_w, v[1]->inv_w, v[2]->inv_w);
+  const float *a0 = v[0]->varyings, *a1 = v[1]->varyings, *a2 = v[2]->varyings;
   for (int i = 0; i < num_varyings; ++i) {
-    for (int k = 0; k < 3; ++k) a[k] = double(v[k]->varyings[i]) * v[k]->inv_w;
-    out.var[i] = make_plane(x, y, a, area2);
+    // float * float is exact in double.
+    out.var[i] = make_plane(g, double(a0[i]) * v[0]->inv_w, double(a1[i]) * v[1]->inv_w,
+                            double(a2[i]) * v[2]->inv_w);
   }
   out.num_varyings = num_varyings;
 }
@@ -92,26 +97,28 @@ int64_t signed_area_fx16(const WindowVertex& v0, const WindowVertex& v1, const W
          (int64_t(v2.x) - v0.x) * (int64_t(v1.y) - v0.y);
 }
 
-bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
-                    int num_varyings, CullMode cull, FrontFace front_face, const PixelRect& scissor,
-                    TriangleSetup& out) {
+bool setup_triangle_coverage(const WindowVertex& v0, const WindowVertex& v1,
+                             const WindowVertex& v2, CullMode cull, FrontFace front_face,
+                             const PixelRect& scissor, TriangleCoverage& out,
+                             const WindowVertex* ordered[3], int64_t& area) {
   // Clipping keeps every vertex inside the guard band; the bit budget of the edge functions
   // (fixed_point.hpp) depends on it.
   for (const WindowVertex* v : {&v0, &v1, &v2}) {
     SOFTRAST_CHECK_LT(std::llabs(v->x), kMaxCoordFx8);
     SOFTRAST_CHECK_LT(std::llabs(v->y), kMaxCoordFx8);
   }
-  int64_t area = signed_area_fx16(v0, v1, v2);
+  area = signed_area_fx16(v0, v1, v2);
   if (area == 0) return false;  // zero area: back-facing by convention, and covers nothing
   if (is_culled(area, cull, front_face)) return false;
   bool ccw = area < 0;  // counter-clockwise as seen in the image (y down)
 
   // Reorder to clockwise so that every edge function is positive inside.
-  const WindowVertex* v[3] = {&v0, &v1, &v2};
-  if (ccw) std::swap(v[1], v[2]);
+  ordered[0] = &v0;
+  ordered[1] = ccw ? &v2 : &v1;
+  ordered[2] = ccw ? &v1 : &v2;
   for (int k = 0; k < 3; ++k) {
-    out.vx[k] = v[k]->x;
-    out.vy[k] = v[k]->y;
+    out.vx[k] = ordered[k]->x;
+    out.vy[k] = ordered[k]->y;
   }
   out.bounds = intersect(triangle_bounds(out.vx, out.vy), scissor);
   if (out.bounds.empty()) return false;
@@ -119,8 +126,24 @@ bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const Window
     int j = (k + 1) % 3;
     out.edge[k] = make_edge(out.vx[k], out.vy[k], out.vx[j], out.vy[j]);
   }
-  setup_planes(v, num_varyings, std::abs(area), out.interp);
-  out.interp.front_facing = is_front_facing(area, front_face);
+  return true;
+}
+
+void setup_triangle_interpolants(const WindowVertex* const ordered[3], int num_varyings,
+                                 int64_t area, FrontFace front_face, Interpolants& out) {
+  setup_planes(ordered, num_varyings, std::abs(area), out);
+  out.front_facing = is_front_facing(area, front_face);
+}
+
+bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
+                    int num_varyings, CullMode cull, FrontFace front_face, const PixelRect& scissor,
+                    TriangleSetup& out) {
+  const WindowVertex* ordered[3];
+  int64_t area = 0;
+  if (!setup_triangle_coverage(v0, v1, v2, cull, front_face, scissor, out, ordered, area)) {
+    return false;
+  }
+  setup_triangle_interpolants(ordered, num_varyings, area, front_face, out.interp);
   return true;
 }
 

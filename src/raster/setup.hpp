@@ -42,12 +42,16 @@ inline int64_t sample_fx8(int i) {
   return int64_t(i) * kSubpixelOne + kSubpixelHalf;
 }
 
-struct TriangleSetup {
+// What the rasterizers read of a triangle.
+struct TriangleCoverage {
   // Vertices in clockwise order as seen in the image (y down), so E > 0 inside every edge.
   int32_t vx[3] = {0, 0, 0};
   int32_t vy[3] = {0, 0, 0};
   EdgeFunction edge[3];  // edge k runs from vertex k to vertex (k + 1) % 3
   PixelRect bounds;      // pixels whose samples can be covered, already inside the scissor
+};
+
+struct TriangleSetup : TriangleCoverage {
   Interpolants interp;
 };
 
@@ -70,6 +74,18 @@ inline bool is_culled(int64_t area, CullMode cull, FrontFace front_face) {
 bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
                     int num_varyings, CullMode cull, FrontFace front_face, const PixelRect& scissor,
                     TriangleSetup& out);
+
+// setup_triangle in two steps, for producers that store the interpolants elsewhere (the bins'
+// compact records). The first culls by the snapped area before any other work, then reorders
+// the vertices clockwise into `ordered` and fills the coverage; false as setup_triangle. The
+// second fills the interpolants (`area` is the first's signed area). setup_triangle is exactly
+// these two calls, so every path sets triangles up identically.
+bool setup_triangle_coverage(const WindowVertex& v0, const WindowVertex& v1,
+                             const WindowVertex& v2, CullMode cull, FrontFace front_face,
+                             const PixelRect& scissor, TriangleCoverage& out,
+                             const WindowVertex* ordered[3], int64_t& area);
+void setup_triangle_interpolants(const WindowVertex* const ordered[3], int num_varyings,
+                                 int64_t area, FrontFace front_face, Interpolants& out);
 
 // A line segment after snapping, with its interpolants (gradients along the major axis only).
 struct LineSetup {

@@ -13,7 +13,7 @@ enum class BlockTest { kOutside, kInside, kPartial };
 // Classifies the samples of the size x size block at pixel (x, y) against the three edges.
 // E is linear, so its extremes over the block's samples are at corner samples chosen by the
 // signs of a and b; the test is exact.
-BlockTest classify_block(const TriangleSetup& tri, int x, int y, int size) {
+BlockTest classify_block(const TriangleCoverage& tri, int x, int y, int size) {
   bool inside = true;
   int64_t span = int64_t(size - 1) * kSubpixelOne;
   int64_t sx = sample_fx8(x), sy = sample_fx8(y);
@@ -29,7 +29,7 @@ BlockTest classify_block(const TriangleSetup& tri, int x, int y, int size) {
 }
 
 // Per-pixel coverage of a 4x4 block (the scalar reference the SIMD paths will be checked with).
-uint32_t block_coverage(const TriangleSetup& tri, int x, int y) {
+uint32_t block_coverage(const TriangleCoverage& tri, int x, int y) {
   uint32_t mask = 0xffffu;
   for (const EdgeFunction& e : tri.edge) {
     int64_t row_start = e.at(sample_fx8(x), sample_fx8(y));
@@ -54,7 +54,7 @@ uint32_t area_mask(const PixelRect& area, int x, int y) {
   return block_rect_mask(c0, c1, r0, r1);
 }
 
-void raster_4x4(const TriangleSetup& tri, const PixelRect& area, int x, int y, BlockTest test,
+void raster_4x4(const TriangleCoverage& tri, const PixelRect& area, int x, int y, BlockTest test,
                 const BlockSink& sink) {
   uint32_t mask = area_mask(area, x, y);
   if (mask == 0) return;
@@ -62,7 +62,7 @@ void raster_4x4(const TriangleSetup& tri, const PixelRect& area, int x, int y, B
   if (mask != 0) sink(x, y, mask);
 }
 
-void raster_16x16(const TriangleSetup& tri, const PixelRect& area, int x, int y,
+void raster_16x16(const TriangleCoverage& tri, const PixelRect& area, int x, int y,
                   const BlockSink& sink) {
   BlockTest test = classify_block(tri, x, y, kMidBlockSize);
   if (test == BlockTest::kOutside) return;
@@ -81,7 +81,7 @@ int align_down(int v, int a) {
 
 }  // namespace
 
-void rasterize_triangle_edge_equations(const TriangleSetup& tri, const PixelRect& region,
+void rasterize_triangle_edge_equations(const TriangleCoverage& tri, const PixelRect& region,
                                        const BlockSink& sink) {
   PixelRect area = intersect(tri.bounds, region);
   if (area.empty()) return;

@@ -27,6 +27,16 @@ struct MeshInputs {
   glm::vec4 clip(uint32_t i) const { return mvp * glm::vec4(mesh->positions[i], 1.0f); }
 };
 
+// Samples at the uv in varyings (i, i + 1), with their derivatives when the filter needs them.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_with_derivatives(const Texture& t, const Sampler& s,
+                                                           const Fragments<N>& f,
+                                      int i) {
+  simd::Vec2<N> uv = f.vec2(i);
+  if (s.filter != Filter::kTrilinear) return sample<N>(t, s, uv);
+  return sample<N>(t, s, uv, {f.ddx(uv.x), f.ddx(uv.y)}, {f.ddy(uv.x), f.ddy(uv.y)});
+}
+
 struct FlatShader {
   static constexpr int kVaryings = 0;
   MeshInputs in;
@@ -68,7 +78,7 @@ struct TextureShader {
   }
   template <int N>
   void shade(Fragments<N>& f) const {
-    simd::Vec4<N> t = sample<N>(*texture, sampler, f.vec2(0));
+    simd::Vec4<N> t = sample_with_derivatives(*texture, sampler, f, 0);
     f.color = {t.x, t.y, t.z, t.w * alpha};
   }
 };
@@ -100,15 +110,16 @@ struct PhongShader {
     F d = simd::max(simd::dot(n, l), F(0.0f));
     F s = simd::select(d > F(0.0f), pow_shininess(simd::max(simd::dot(n, h), F(0.0f))), F(0.0f));
     simd::Vec4<N> base{F(albedo.r), F(albedo.g), F(albedo.b), F(1.0f)};
-    if (texture) base = sample<N>(*texture, sampler, f.vec2(6));
+    if (texture) base = sample_with_derivatives(*texture, sampler, f, 6);
     F lit = F(kAmbient) + F(kDiffuse) * d;
     F spec = F(kSpecular) * s;
     f.color = {base.x * lit + spec, base.y * lit + spec, base.z * lit + spec, base.w * alpha};
   }
   // x^32 by five squarings (kShininess is 32).
   template <int N>
-  static simd::Float<N> pow_shininess(simd::Float<N> x) {
+  static simd::Float<N> pow_shininess(const simd::Float<N>& base) {
     static_assert(kShininess == 32.0f);
+    simd::Float<N> x = base;
     for (int k = 0; k < 5; ++k) x = x * x;
     return x;
   }

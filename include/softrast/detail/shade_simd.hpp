@@ -5,6 +5,11 @@
 // Internal: included through softrast/shader.hpp.
 #pragma once
 
+// Wide vectors are passed by value between inlined helpers; GCC notes that the ABI of such
+// parameters changed in GCC 4.6, which cannot matter here (nothing crosses a library boundary).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -123,9 +128,10 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> unpack_rgba8(const simd::Int<N>& p) {
 
 // blend_pixel for 16 lanes, the same formulas in the same order.
 template <int N>
-SOFTRAST_SIMD_INLINE simd::Int<N> blend(BlendMode mode, simd::Vec4<N> src,
+SOFTRAST_SIMD_INLINE simd::Int<N> blend(BlendMode mode, const simd::Vec4<N>& colour,
                                         const simd::Int<N>& dst_packed) {
   using F = simd::Float<N>;
+  simd::Vec4<N> src = colour;
   if (mode == BlendMode::kOpaque) return pack_rgba8(src);
   const F zero(0.0f), one(1.0f);
   src = {simd::clamp(src.x, zero, one), simd::clamp(src.y, zero, one),
@@ -279,3 +285,5 @@ ShadeBlockFn wide_shade_block(SimdLevel level) {
 
 }  // namespace detail
 }  // namespace softrast
+
+#pragma GCC diagnostic pop

@@ -3,6 +3,11 @@
 // Internal: included through softrast/shader.hpp; shaders call softrast::sample().
 #pragma once
 
+// Wide vectors are passed by value between inlined helpers; GCC notes that the ABI of such
+// parameters changed in GCC 4.6, which cannot matter here (nothing crosses a library boundary).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 #include <cstring>
 
 #include "softrast/simd.hpp"
@@ -23,26 +28,32 @@ SOFTRAST_SIMD_INLINE simd::Int<N> texel_floor(const simd::Float<N>& x, simd::Flo
   return i;
 }
 
+// Wraps texel indices into [0, size) per lane (sizes may differ by lane: mip levels).
+// `pow2` says every lane's size is a power of two.
 template <int N>
-SOFTRAST_SIMD_INLINE simd::Int<N> wrap_texel(Wrap mode, const simd::Int<N>& i, int size) {
+SOFTRAST_SIMD_INLINE simd::Int<N> wrap_texel(Wrap mode, const simd::Int<N>& i,
+                                             const simd::Int<N>& size, bool pow2) {
   using I = simd::Int<N>;
   if (mode == Wrap::kClampToEdge) {
-    return simd::select(i < I(0), I(0), simd::select(i > I(size - 1), I(size - 1), i));
+    I last = size - I(1);
+    return simd::select(i < I(0), I(0), simd::select(i > last, last, i));
   }
-  if (mode == Wrap::kRepeat && (size & (size - 1)) == 0) return i & I(size - 1);
+  if (mode == Wrap::kRepeat && pow2) return i & (size - I(1));
   I r;  // repeat of other sizes and mirrored repeat: a division per lane, the scalar rule
   for (int lane = 0; lane < simd::kLanes; ++lane) {
-    r.p[lane / N][lane % N] = Texture::wrap(mode, i.lane(lane), size);
+    r.p[lane / N][lane % N] = Texture::wrap(mode, i.lane(lane), size.lane(lane));
   }
   return r;
 }
 
+// Texel (i, j) of the level whose size and first texel are (w, h, offset), lane by lane.
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> fetch(const Texture& t, const simd::Int<N>& i,
-                                         const simd::Int<N>& j) {
+                                         const simd::Int<N>& j, const simd::Int<N>& w,
+                                         const simd::Int<N>& offset) {
   using F = simd::Float<N>;
-  simd::Int<N> texel = simd::gather<N>(reinterpret_cast<const int32_t*>(t.texels()),
-                                       j * simd::Int<N>(t.width()) + i);
+  simd::Int<N> texel =
+      simd::gather<N>(reinterpret_cast<const int32_t*>(t.texels()), offset + j * w + i);
   const F k(1.0f / 255.0f);
   simd::Int<N> byte(0xff);
   return {simd::to_float(texel & byte) * k, simd::to_float((texel >> 8) & byte) * k,
@@ -56,6 +67,64 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> lerp(const simd::Vec4<N>& a, const simd::Vec4
   return {a.x * s + b.x * t, a.y * s + b.y * t, a.z * s + b.z * t, a.w * s + b.w * t};
 }
 
+// One level per lane (size w x h, first texel `offset`), nearest or bilinear: the arithmetic of
+// Texture::sample_nearest / sample_bilinear in the same order.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_level(const Texture& t, const Sampler& s,
+                                                const simd::Vec2<N>& uv, const simd::Int<N>& w,
+                                                const simd::Int<N>& h,
+                                                const simd::Int<N>& offset, bool pow2_u,
+                                                bool pow2_v, bool nearest) {
+  using F = simd::Float<N>;
+  using I = simd::Int<N>;
+  F fx, fy;
+  F wf = simd::to_float(w), hf = simd::to_float(h);
+  if (nearest) {
+    I i = wrap_texel<N>(s.wrap_u, texel_floor<N>(uv.x * wf, fx), w, pow2_u);
+    I j = wrap_texel<N>(s.wrap_v, texel_floor<N>(uv.y * hf, fy), h, pow2_v);
+    return fetch<N>(t, i, j, w, offset);
+  }
+  // Texel centres sit at half-integers: shift by half a texel, then split (GL_LINEAR).
+  I x0 = texel_floor<N>(uv.x * wf - F(0.5f), fx);
+  I y0 = texel_floor<N>(uv.y * hf - F(0.5f), fy);
+  I one(1);
+  I i0 = wrap_texel<N>(s.wrap_u, x0, w, pow2_u);
+  I i1 = wrap_texel<N>(s.wrap_u, x0 + one, w, pow2_u);
+  I j0 = wrap_texel<N>(s.wrap_v, y0, h, pow2_v);
+  I j1 = wrap_texel<N>(s.wrap_v, y0 + one, h, pow2_v);
+  simd::Vec4<N> bottom =
+      lerp<N>(fetch<N>(t, i0, j0, w, offset), fetch<N>(t, i1, j0, w, offset), fx);
+  simd::Vec4<N> top = lerp<N>(fetch<N>(t, i0, j1, w, offset), fetch<N>(t, i1, j1, w, offset), fx);
+  return lerp<N>(bottom, top, fy);
+}
+
+// fast_log2 (texture.hpp) for 16 lanes, the same operations.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Float<N> fast_log2(const simd::Float<N>& x) {
+  using F = simd::Float<N>;
+  using I = simd::Int<N>;
+  I bits = simd::bit_cast_int(x);
+  F exponent = simd::to_float((bits >> 23) - I(127));
+  F m = simd::bit_cast_float((bits & I(0x007fffff)) | I(0x3f800000));
+  F t = m - F(1.0f);
+  F p = t * (F(1.44182512f) +
+             t * (F(-0.708674935f) +
+                  t * (F(0.415397767f) + t * (F(-0.194390433f) + t * F(0.0458707517f)))));
+  return exponent + p;
+}
+
+// The mip level sizes and offsets of each lane's level `l` (0 <= l < levels).
+template <int N>
+SOFTRAST_SIMD_INLINE void level_lanes(const Texture& t, const simd::Int<N>& l, simd::Int<N>& w,
+                                      simd::Int<N>& h, simd::Int<N>& offset) {
+  for (int lane = 0; lane < simd::kLanes; ++lane) {
+    const MipLevel& m = t.level(l.lane(lane));
+    w.p[lane / N][lane % N] = m.width;
+    h.p[lane / N][lane % N] = m.height;
+    offset.p[lane / N][lane % N] = int32_t(m.offset);
+  }
+}
+
 }  // namespace detail
 
 // Samples `texture` at 16 texture coordinates with the sampler's filter and wrap modes; an empty
@@ -64,27 +133,45 @@ template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler& s,
                                           const simd::Vec2<N>& uv) {
   using F = simd::Float<N>;
+  using I = simd::Int<N>;
   if (texture.empty()) return {F(1.0f), F(1.0f), F(1.0f), F(1.0f)};
   const int w = texture.width(), h = texture.height();
-  F fx, fy;
-  if (s.filter == Filter::kNearest) {
-    simd::Int<N> i = detail::wrap_texel<N>(s.wrap_u, detail::texel_floor<N>(uv.x * F(float(w)), fx), w);
-    simd::Int<N> j = detail::wrap_texel<N>(s.wrap_v, detail::texel_floor<N>(uv.y * F(float(h)), fy), h);
-    return detail::fetch<N>(texture, i, j);
-  }
-  // Texel centres sit at half-integers: shift by half a texel, then split (GL_LINEAR).
-  simd::Int<N> x0 = detail::texel_floor<N>(uv.x * F(float(w)) - F(0.5f), fx);
-  simd::Int<N> y0 = detail::texel_floor<N>(uv.y * F(float(h)) - F(0.5f), fy);
-  simd::Int<N> one(1);
-  simd::Int<N> i0 = detail::wrap_texel<N>(s.wrap_u, x0, w);
-  simd::Int<N> i1 = detail::wrap_texel<N>(s.wrap_u, x0 + one, w);
-  simd::Int<N> j0 = detail::wrap_texel<N>(s.wrap_v, y0, h);
-  simd::Int<N> j1 = detail::wrap_texel<N>(s.wrap_v, y0 + one, h);
-  simd::Vec4<N> bottom = detail::lerp<N>(detail::fetch<N>(texture, i0, j0),
-                                         detail::fetch<N>(texture, i1, j0), fx);
-  simd::Vec4<N> top = detail::lerp<N>(detail::fetch<N>(texture, i0, j1),
-                                      detail::fetch<N>(texture, i1, j1), fx);
-  return detail::lerp<N>(bottom, top, fy);
+  return detail::sample_level<N>(texture, s, uv, I(w), I(h), I(0), (w & (w - 1)) == 0,
+                                 (h & (h - 1)) == 0, s.filter == Filter::kNearest);
+}
+
+// The same with the texture coordinates' change to the next pixel right and down (for example
+// {f.ddx(uv.x), f.ddx(uv.y)}), which choose the mip levels of Filter::kTrilinear: the same
+// results as Texture::sample(s, uv, duv_dx, duv_dy), lane by lane.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler& s,
+                                          const simd::Vec2<N>& uv, const simd::Vec2<N>& duv_dx,
+                                          const simd::Vec2<N>& duv_dy) {
+  using F = simd::Float<N>;
+  using I = simd::Int<N>;
+  if (texture.empty() || s.filter != Filter::kTrilinear) return sample<N>(texture, s, uv);
+  const float w = float(texture.width()), h = float(texture.height());
+  F xx = duv_dx.x * F(w), xy = duv_dx.y * F(h), yx = duv_dy.x * F(w), yy = duv_dy.y * F(h);
+  F a = xx * xx + xy * xy, b = yx * yx + yy * yy;
+  F rho2 = simd::select(a < b, b, a);  // std::max(a, b)
+  F lod = F(0.5f) * detail::fast_log2<N>(rho2);
+  F top(float(texture.levels() - 1));
+  I magnify = ~(lod > F(0.0f));  // lod <= 0 or NaN: the base level
+  F d = simd::select(magnify, F(0.0f), simd::select(lod < top, lod, top));
+  I l0 = simd::to_int(d);
+  F t = d - simd::to_float(l0);
+  I l1 = simd::select(l0 < simd::to_int(top), l0 + I(1), l0);
+  // Halving a power of two (down to 1) keeps it one, so the base level decides for every level.
+  int tw = texture.width(), th = texture.height();
+  bool pow2_u = (tw & (tw - 1)) == 0, pow2_v = (th & (th - 1)) == 0;
+  I w0, h0, o0, w1, h1, o1;
+  detail::level_lanes<N>(texture, l0, w0, h0, o0);
+  detail::level_lanes<N>(texture, l1, w1, h1, o1);
+  simd::Vec4<N> c0 = detail::sample_level<N>(texture, s, uv, w0, h0, o0, pow2_u, pow2_v, false);
+  simd::Vec4<N> c1 = detail::sample_level<N>(texture, s, uv, w1, h1, o1, pow2_u, pow2_v, false);
+  return detail::lerp<N>(c0, c1, t);
 }
 
 }  // namespace softrast
+
+#pragma GCC diagnostic pop

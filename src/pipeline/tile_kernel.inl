@@ -1,0 +1,360 @@
+// pipeline/tile_kernel.inl: the body of the tile kernels (tile_kernels.hpp), written once and
+// included by tile_kernels.cpp once per instruction set, inside its own namespace, with
+// SOFTRAST_LANES (4, 8 or 16 lanes of 32 bits) defined and the matching `#pragma GCC target` in
+// force. Vectors are GCC vector extensions; only pointers and scalars cross the entry points, so
+// the ABIs of the three copies never meet.
+
+constexpr int kLanes = SOFTRAST_LANES;
+constexpr int kGroups = 16 / kLanes;  // a 4x4 block is kGroups vectors of kLanes pixels
+typedef float F __attribute__((vector_size(4 * kLanes)));
+typedef int32_t I __attribute__((vector_size(4 * kLanes)));
+typedef int64_t L __attribute__((vector_size(8 * kLanes)));
+
+// Lane l of group g is pixel p = g * kLanes + l of the block: column p & 3, row p >> 2 (the bit
+// of the coverage masks).
+[[gnu::always_inline]] inline I pixel_index(int g) {
+  I v;
+  for (int l = 0; l < kLanes; ++l) v[l] = g * kLanes + l;
+  return v;
+}
+
+// The sign bits of the lanes (all-ones or zero) as bits 0 .. kLanes-1.
+[[gnu::always_inline]] inline uint32_t lane_bits(I v) {
+#if SOFTRAST_LANES == 16
+  return uint32_t(_mm512_movepi32_mask(reinterpret_cast<__m512i>(v)));
+#elif SOFTRAST_LANES == 8
+  return uint32_t(_mm256_movemask_ps(reinterpret_cast<__m256>(v)));
+#else
+  return uint32_t(_mm_movemask_ps(reinterpret_cast<__m128>(v)));
+#endif
+}
+
+// ---------------------------------------------------------------------------------------------
+// Coverage of one 4x4 block: E(pixel) = E(block's first sample) + a * 256 * column + b * 256 *
+// row for each edge; a pixel is covered when all three are >= 0, i.e. when the bitwise or of the
+// three is (the sign bit of the or is set iff one of them is negative).
+
+template <class V>
+struct EdgeOffsets {
+  V off[3][kGroups];
+};
+
+template <class V, class T>
+[[gnu::always_inline]] inline void make_offsets(const TriangleCoverage& t, EdgeOffsets<V>& o) {
+  for (int g = 0; g < kGroups; ++g) {
+    I p = pixel_index(g);
+    V column = __builtin_convertvector(p & 3, V), row = __builtin_convertvector(p >> 2, V);
+    for (int k = 0; k < 3; ++k) {
+      o.off[k][g] = T(t.edge[k].a * kSubpixelOne) * column + T(t.edge[k].b * kSubpixelOne) * row;
+    }
+  }
+}
+
+// `e`: the three edge functions at the block's first sample. T is int32_t only where
+// fixed_point.hpp's kSmallTriangleFx8 bound proves every value fits.
+template <class V, class T>
+[[gnu::always_inline]] inline uint32_t coverage_bits(const int64_t e[3],
+                                                     const EdgeOffsets<V>& o) {
+  uint32_t bits = 0;
+  for (int g = 0; g < kGroups; ++g) {
+    V all = (T(e[0]) + o.off[0][g]) | (T(e[1]) + o.off[1][g]) | (T(e[2]) + o.off[2][g]);
+    bits |= lane_bits(__builtin_convertvector(all >= 0, I)) << (g * kLanes);
+  }
+  return bits;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The depth resolve of one block (tile_visibility.hpp): the fragment stage's depth, exactly, tested
+// against the tile's depth; where it passes, depth and winner id are written.
+//
+// The fragment stage computes dx = (float(px) + 0.5f) - x_ref and z = clamp((a0 + dadx * dx) +
+// dady * dy, 0, 1) with std::clamp (NaN stays NaN, -0 stays -0), without contraction. Here
+// float(px) + 0.5f is formed as (float(x) + 0.5f) + column: both are exact (integers and
+// half-integers below 2^23, the image is at most 16384 wide), so only the subtraction of x_ref
+// rounds, as there. std::clamp(z, 0, 1) is `z < 0 ? 0 : (1 < z ? 1 : z)`, which is exactly
+// max(0, min(1, z)) with x86's operand order (MINPS returns its second operand unless the first
+// is smaller, so NaN and -0 come through as z).
+
+// A triangle's depth plane over an area of at most a tile, as its two halves: the fragment
+// stage's z = (a0 + dadx * dx) + dady * dy is the sum of a term per block column and a term per
+// block row, each computed once from the same operands (so each block's z is the same float sum,
+// for one addition).
+struct DepthTerms {
+  static constexpr int kMax = kTileSize / kBlockSize;
+  F x_term[kMax][kGroups];  // a0 + dadx * dx, block column i (pixels x0 + 4 i ..)
+  F y_term[kMax][kGroups];  // dady * dy, block row j
+  int x0, y0;
+  int32_t id;
+};
+
+// Terms for the blocks of [x0, x1) x [y0, y1); x0 and y0 multiples of 4, at most a tile.
+[[gnu::always_inline]] inline void depth_terms(const Interpolants& in, int32_t id, int x0, int x1,
+                                               int y0, int y1, DepthTerms& d) {
+  d.x0 = x0;
+  d.y0 = y0;
+  d.id = id;
+  F x_ref = F{} + in.x_ref, y_ref = F{} + in.y_ref;
+  for (int g = 0; g < kGroups; ++g) {
+    I p = pixel_index(g);
+    F column = __builtin_convertvector(p & 3, F), row = __builtin_convertvector(p >> 2, F);
+    for (int i = 0; x0 + kBlockSize * i < x1; ++i) {
+      F dx = ((F{} + (float(x0 + kBlockSize * i) + 0.5f)) + column) - x_ref;
+      d.x_term[i][g] = in.z.a0 + in.z.dadx * dx;
+    }
+    for (int j = 0; y0 + kBlockSize * j < y1; ++j) {
+      F dy = ((F{} + (float(y0 + kBlockSize * j) + 0.5f)) + row) - y_ref;
+      d.y_term[j][g] = in.z.dady * dy;
+    }
+  }
+}
+
+// min(1, z) and max(0, z) with the operand order of std::clamp (see above).
+[[gnu::always_inline]] inline F clamp01(F z) {
+#if SOFTRAST_LANES == 16
+  __m512 m = _mm512_min_ps(_mm512_set1_ps(1.0f), reinterpret_cast<__m512>(z));
+  return reinterpret_cast<F>(_mm512_max_ps(_mm512_setzero_ps(), m));
+#elif SOFTRAST_LANES == 8
+  __m256 m = _mm256_min_ps(_mm256_set1_ps(1.0f), reinterpret_cast<__m256>(z));
+  return reinterpret_cast<F>(_mm256_max_ps(_mm256_setzero_ps(), m));
+#else
+  __m128 m = _mm_min_ps(_mm_set1_ps(1.0f), reinterpret_cast<__m128>(z));
+  return reinterpret_cast<F>(_mm_max_ps(_mm_setzero_ps(), m));
+#endif
+}
+
+// Depth test of the lanes of `mask` (bits of the group's pixels) and the write of the winners.
+template <bool kLessEqual>
+[[gnu::always_inline]] inline void test_and_write(F z, uint32_t mask, int32_t id, float* depth,
+                                                  int32_t* ids) {
+#if SOFTRAST_LANES == 16
+  // AVX-512: the test runs under the coverage mask and the winners are masked stores.
+  __m512 stored = _mm512_loadu_ps(depth);
+  __mmask16 pass = _mm512_mask_cmp_ps_mask(__mmask16(mask), reinterpret_cast<__m512>(z), stored,
+                                           kLessEqual ? _CMP_LE_OQ : _CMP_LT_OQ);
+  _mm512_mask_storeu_ps(depth, pass, reinterpret_cast<__m512>(z));
+  _mm512_mask_storeu_epi32(ids, pass, _mm512_set1_epi32(id));
+#else
+  F stored;
+  I winner;
+  std::memcpy(&stored, depth, sizeof(F));
+  std::memcpy(&winner, ids, sizeof(I));
+  I bit = I{} + 1;
+  for (int l = 0; l < kLanes; ++l) bit[l] <<= l;
+  I covered = ((I{} + int32_t(mask)) & bit) != 0;
+  I pass = (kLessEqual ? (z <= stored) : (z < stored)) & covered;
+  stored = pass ? z : stored;
+  winner = pass ? (I{} + id) : winner;
+  std::memcpy(depth, &stored, sizeof(F));
+  std::memcpy(ids, &winner, sizeof(I));
+#endif
+}
+
+template <bool kLessEqual>
+[[gnu::always_inline]] inline void resolve_lanes(const DepthTerms& d, int x, int y, uint32_t mask,
+                                                 float* depth, int32_t* ids) {
+  const F* x_term = d.x_term[(x - d.x0) >> 2];
+  const F* y_term = d.y_term[(y - d.y0) >> 2];
+  for (int g = 0; g < kGroups; ++g) {
+    uint32_t group_mask = (mask >> (g * kLanes)) & ((1u << kLanes) - 1u);
+    if (kGroups > 1 && group_mask == 0) continue;
+    F z = clamp01(x_term[g] + y_term[g]);
+    test_and_write<kLessEqual>(z, group_mask, d.id, depth + g * kLanes, ids + g * kLanes);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// One record in one tile.
+
+enum class Mode { kImmediate, kLess, kLessEqual };
+
+// The pixels of the block at (x, y) inside the tile's region (only the image's last row and
+// column of tiles are cut).
+[[gnu::always_inline]] inline uint32_t region_bits(const PixelRect& r, int x, int y) {
+  if (x + kBlockSize <= r.x1 && y + kBlockSize <= r.y1) return 0xffffu;
+  return block_rect_mask(0, std::min(kBlockSize, r.x1 - x), 0, std::min(kBlockSize, r.y1 - y));
+}
+
+// Where a record's covered blocks go: the fragment stage, or the tile's depth resolve.
+template <Mode kMode>
+struct BlockTarget {
+  TileJob& job;
+  const TriRecord& rec;
+  DepthTerms depth;
+
+  BlockTarget(TileJob& j, const TriRecord& r, int32_t id, const PixelRect& area) : job(j), rec(r) {
+    if constexpr (kMode != Mode::kImmediate) {
+      depth_terms(r.interp(), id, area.x0 & ~(kBlockSize - 1), area.x1,
+                  area.y0 & ~(kBlockSize - 1), area.y1, depth);
+    }
+  }
+  [[gnu::always_inline]] void operator()(int x, int y, uint32_t bits) {
+    if constexpr (kMode == Mode::kImmediate) {
+      job.program->shade_block(job.program->shader, *job.target, rec.interp(), x, y, bits);
+    } else {
+      TileVisibility& v = *job.visibility;
+      int b = v.block(x, y);
+      resolve_lanes<kMode == Mode::kLessEqual>(depth, x, y, bits, v.depth[b], v.id[b]);
+    }
+  }
+};
+
+// Exact block classification against the three edges, as tile_raster.cpp's: E is linear, so its
+// extremes over the block's samples are at the corner samples picked by the signs of a and b.
+struct EdgeExtents {
+  int64_t lo[3], hi[3];  // added to E at the block's first sample: its minimum and maximum
+};
+[[gnu::always_inline]] inline EdgeExtents edge_extents(const TriangleCoverage& t, int size) {
+  EdgeExtents x;
+  int64_t span = int64_t(size - 1) * kSubpixelOne;
+  for (int k = 0; k < 3; ++k) {
+    int64_t ax = t.edge[k].a * span, by = t.edge[k].b * span;
+    x.lo[k] = std::min<int64_t>(ax, 0) + std::min<int64_t>(by, 0);
+    x.hi[k] = std::max<int64_t>(ax, 0) + std::max<int64_t>(by, 0);
+  }
+  return x;
+}
+enum class Test { kOutside, kInside, kPartial };
+[[gnu::always_inline]] inline Test classify(const int64_t e[3], const EdgeExtents& x) {
+  bool inside = true;
+  for (int k = 0; k < 3; ++k) {
+    if (e[k] + x.hi[k] < 0) return Test::kOutside;
+    if (e[k] + x.lo[k] < 0) inside = false;
+  }
+  return inside ? Test::kInside : Test::kPartial;
+}
+
+// Edge values at the first sample of block (x, y), from those at (x0, y0) (exact int64).
+struct EdgeGrid {
+  int64_t origin[3], step_x[3], step_y[3];  // per pixel
+  int x0, y0;
+  void at(int x, int y, int64_t e[3]) const {
+    for (int k = 0; k < 3; ++k) {
+      e[k] = origin[k] + step_x[k] * (x - x0) + step_y[k] * (y - y0);
+    }
+  }
+};
+
+template <Mode kMode, class V, class T>
+[[gnu::always_inline]] inline void raster_record_with(TileJob& job, const TriRecord& rec,
+                                                      int32_t id, const PixelRect& area,
+                                                      const EdgeGrid& grid) {
+  const TriangleCoverage& t = rec.coverage;
+  BlockTarget<kMode> emit(job, rec, id, area);
+  EdgeOffsets<V> offsets;
+  make_offsets<V, T>(t, offsets);
+  int bx0 = area.x0 & ~(kBlockSize - 1), by0 = area.y0 & ~(kBlockSize - 1);
+  auto partial_block = [&](int x, int y) {
+    int64_t e[3];
+    grid.at(x, y, e);
+    uint32_t bits = coverage_bits<V, T>(e, offsets) & region_bits(job.region, x, y);
+    if (bits != 0) emit(x, y, bits);
+  };
+  // Small areas (at most 16x16 pixels of blocks, the usual triangle of a dense mesh): every
+  // block's coverage directly, no classification.
+  if (area.x1 - bx0 <= kMidBlockSize && area.y1 - by0 <= kMidBlockSize) {
+    for (int y = by0; y < area.y1; y += kBlockSize) {
+      for (int x = bx0; x < area.x1; x += kBlockSize) partial_block(x, y);
+    }
+    return;
+  }
+  // Larger: 16x16 blocks, then 4x4 blocks, trivially rejected or accepted (a block inside every
+  // edge is emitted without per-pixel tests); only the rest is tested pixel by pixel.
+  EdgeExtents mid = edge_extents(t, kMidBlockSize), small = edge_extents(t, kBlockSize);
+  int mx0 = area.x0 & ~(kMidBlockSize - 1), my0 = area.y0 & ~(kMidBlockSize - 1);
+  for (int my = my0; my < area.y1; my += kMidBlockSize) {
+    for (int mx = mx0; mx < area.x1; mx += kMidBlockSize) {
+      int64_t e[3];
+      grid.at(mx, my, e);
+      Test test = classify(e, mid);
+      if (test == Test::kOutside) continue;
+      // Only blocks that overlap the area (the 32-bit bound in fixed_point.hpp relies on it).
+      int y_end = std::min(my + kMidBlockSize, area.y1), x_end = std::min(mx + kMidBlockSize, area.x1);
+      for (int y = std::max(my, by0); y < y_end; y += kBlockSize) {
+        for (int x = std::max(mx, bx0); x < x_end; x += kBlockSize) {
+          Test sub = test;
+          if (test == Test::kPartial) {
+            grid.at(x, y, e);
+            sub = classify(e, small);
+          }
+          if (sub == Test::kInside) {
+            emit(x, y, region_bits(job.region, x, y));
+          } else if (sub == Test::kPartial) {
+            partial_block(x, y);
+          }
+        }
+      }
+    }
+  }
+}
+
+template <Mode kMode>
+[[gnu::always_inline]] inline void raster_record(TileJob& job, const TriRecord& rec, int32_t id) {
+  const TriangleCoverage& t = rec.coverage;
+  PixelRect area = intersect(t.bounds, job.region);
+  if (area.empty()) return;
+  EdgeGrid grid;
+  grid.x0 = area.x0 & ~(kBlockSize - 1);
+  grid.y0 = area.y0 & ~(kBlockSize - 1);
+  for (int k = 0; k < 3; ++k) {
+    grid.origin[k] = t.edge[k].at(sample_fx8(grid.x0), sample_fx8(grid.y0));
+    grid.step_x[k] = t.edge[k].a * kSubpixelOne;
+    grid.step_y[k] = t.edge[k].b * kSubpixelOne;
+  }
+  if (rec.small && area.x1 - grid.x0 <= kBlockSize && area.y1 - grid.y0 <= kBlockSize) {
+    // Inside one block (the usual triangle of a dense mesh): that block's coverage, nothing else.
+    EdgeOffsets<I> offsets;
+    make_offsets<I, int32_t>(t, offsets);
+    uint32_t bits = coverage_bits<I, int32_t>(grid.origin, offsets) &
+                    region_bits(job.region, grid.x0, grid.y0);
+    if (bits != 0) BlockTarget<kMode>(job, rec, id, area)(grid.x0, grid.y0, bits);
+    return;
+  }
+  if (rec.small) {
+    raster_record_with<kMode, I, int32_t>(job, rec, id, area, grid);
+  } else {
+    raster_record_with<kMode, L, int64_t>(job, rec, id, area, grid);
+  }
+}
+
+template <Mode kMode>
+[[gnu::always_inline]] inline void raster_records(TileJob& job, const std::byte* arena,
+                                                  const uint32_t* offsets, size_t count) {
+  for (size_t i = 0; i < count; ++i) {
+    const TriRecord& rec = *reinterpret_cast<const TriRecord*>(arena + offsets[i]);
+    int32_t id = 0;
+    if constexpr (kMode != Mode::kImmediate) {
+      id = job.next_id++;
+      job.interps[id] = &rec.interp();
+    }
+    raster_record<kMode>(job, rec, id);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Entry points.
+
+void raster_immediate(TileJob& job, const std::byte* arena, const uint32_t* offsets,
+                      size_t count) {
+  raster_records<Mode::kImmediate>(job, arena, offsets, count);
+}
+void raster_deferred(TileJob& job, const std::byte* arena, const uint32_t* offsets, size_t count) {
+  if (job.less_equal) {
+    raster_records<Mode::kLessEqual>(job, arena, offsets, count);
+  } else {
+    raster_records<Mode::kLess>(job, arena, offsets, count);
+  }
+}
+void resolve_block(const DepthPlaneRef& plane, int x, int y, uint32_t mask, int32_t id,
+                   bool less_equal, float* depth, int32_t* ids) {
+  Interpolants in;
+  in.x_ref = plane.x_ref;
+  in.y_ref = plane.y_ref;
+  in.z = plane.z;
+  DepthTerms d;
+  depth_terms(in, id, x, x + kBlockSize, y, y + kBlockSize, d);
+  if (less_equal) {
+    resolve_lanes<true>(d, x, y, mask, depth, ids);
+  } else {
+    resolve_lanes<false>(d, x, y, mask, depth, ids);
+  }
+}

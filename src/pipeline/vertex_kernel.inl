@@ -1,0 +1,69 @@
+// pipeline/vertex_kernel.inl: the body of vertex_kernels.cpp, included once per instruction set
+// inside its own namespace with SOFTRAST_DOUBLES (2, 4 or 8 lanes of double) defined and the
+// matching `#pragma GCC target` in force. Each step below is the scalar code's step, lane-wise;
+// the comments name the scalar line it mirrors.
+
+constexpr int kD = SOFTRAST_DOUBLES;
+typedef double D __attribute__((vector_size(8 * kD)));
+typedef int64_t Q __attribute__((vector_size(8 * kD)));
+
+// std::nearbyint: the current rounding mode (round half to even by default).
+[[gnu::always_inline]] inline D round_current(D v) {
+#if SOFTRAST_DOUBLES == 8
+  return reinterpret_cast<D>(_mm512_roundscale_pd(reinterpret_cast<__m512d>(v),
+                                                  _MM_FROUND_CUR_DIRECTION | _MM_FROUND_NO_EXC));
+#elif SOFTRAST_DOUBLES == 4
+  return reinterpret_cast<D>(_mm256_round_pd(reinterpret_cast<__m256d>(v),
+                                             _MM_FROUND_CUR_DIRECTION | _MM_FROUND_NO_EXC));
+#else
+  for (int l = 0; l < kD; ++l) v[l] = std::nearbyint(v[l]);  // SSE2 has no rounding instruction
+  return v;
+#endif
+}
+
+// std::clamp(v, lo, hi) = v < lo ? lo : (hi < v ? hi : v), NaN passing through.
+[[gnu::always_inline]] inline D clamp_like_std(D v, double lo, double hi) {
+  D lo_v = D{} + lo, hi_v = D{} + hi;
+  D upper = (hi_v < v) ? hi_v : v;
+  return (v < lo_v) ? lo_v : upper;
+}
+
+// viewport.cpp's snap(): nearbyint(c * 256), NaN to 0, clamped to the fixed-point range.
+[[gnu::always_inline]] inline Q snap(D window_coord) {
+  D fx = round_current(window_coord * double(kSubpixelOne));
+  fx = (fx == fx) ? fx : D{};
+  double limit = double(kMaxCoordFx8 - 1);
+  return __builtin_convertvector(clamp_like_std(fx, -limit, limit), Q);
+}
+
+void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
+  const double min_w = double(kMinClipW), width = b.width, height = b.height;
+  for (size_t i = begin; i < end; i += kD) {
+    size_t lanes = std::min<size_t>(kD, end - i);
+    D x, y, z, w;
+    for (int l = 0; l < kD; ++l) {
+      // Past the end, repeat the last vertex (computed, not stored).
+      const float* p = b.data + (i + std::min<size_t>(l, lanes - 1)) * size_t(b.stride);
+      x[l] = p[0], y[l] = p[1], z[l] = p[2], w[l] = p[3];
+    }
+    // clip.cpp: is_finite_position, then clip_outcode's plane_distance(p) >= 0 per plane.
+    Q finite = (x - x == 0.0) & (y - y == 0.0) & (z - z == 0.0) & (w - w == 0.0);
+    Q code = (~Q(w - min_w >= 0.0) & 1) | (~Q(z + w >= 0.0) & 2) | (~Q(w - z >= 0.0) & 4) |
+             (~Q(x + b.guard_x * w >= 0.0) & 8) | (~Q(b.guard_x * w - x >= 0.0) & 16) |
+             (~Q(y + b.guard_y * w >= 0.0) & 32) | (~Q(b.guard_y * w - y >= 0.0) & 64);
+    code = finite ? code : (Q{} + (int64_t(1) << kNumClipPlanes));
+    // viewport.cpp: Viewport::to_window.
+    D inv_w = 1.0 / w;
+    D x_ndc = x * inv_w, y_ndc = y * inv_w, z_ndc = z * inv_w;
+    Q wx = snap((x_ndc + 1.0) * 0.5 * width);
+    Q wy = snap((1.0 - y_ndc) * 0.5 * height);
+    D wz = clamp_like_std((z_ndc + 1.0) * 0.5, 0.0, 1.0);
+    for (size_t l = 0; l < lanes; ++l) {
+      b.codes[i + l] = uint8_t(code[l]);
+      float zf = float(wz[l]);
+      // geometry_stage.hpp: the depth bias, in float.
+      if (b.depth_bias != 0.0f) zf = std::clamp(zf + b.depth_bias, 0.0f, 1.0f);
+      b.window[i + l] = {int32_t(wx[l]), int32_t(wy[l]), zf, float(inv_w[l])};
+    }
+  }
+}

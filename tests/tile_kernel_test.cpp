@@ -1,0 +1,165 @@
+// The tile kernels (pipeline/tile_kernels.hpp) at every SIMD level this CPU has, against the
+// edge-equation rasterizer: the same blocks with the same masks, tile by tile, for triangles on
+// both sides of the 32-bit bound (fixed_point.hpp's kSmallTriangleFx8), tiny ones inside one
+// block, huge ones, and the image's cut last row and column of tiles.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <random>
+#include <utility>
+
+#include "pipeline/tile_kernels.hpp"
+#include "raster/raster.hpp"
+#include "softrast/shader.hpp"
+
+namespace softrast {
+namespace {
+
+using detail::PixelRect;
+using Blocks = std::map<std::pair<int, int>, uint32_t>;
+
+// A fragment program that records the blocks it is given (the shader pointer is the map).
+void record_block(const void* shader, const detail::ShadeTarget&, const detail::Interpolants&,
+                  int x, int y, uint32_t mask) {
+  auto& blocks = *static_cast<Blocks*>(const_cast<void*>(shader));
+  EXPECT_EQ(blocks.count({x, y}), 0u) << "block emitted twice";
+  blocks[{x, y}] = mask;
+}
+
+void collect(void* context, int x, int y, uint32_t mask) {
+  (*static_cast<Blocks*>(context))[{x, y}] = mask;
+}
+
+// One record in an arena, as the binned draw makes it.
+struct OneRecord {
+  alignas(8) std::byte bytes[detail::record_bytes(0)];
+  explicit OneRecord(const detail::TriangleSetup& tri) {
+    auto* rec = new (bytes) detail::TriRecord;
+    rec->coverage = tri;
+    auto extent = [](const int32_t v[3]) {
+      return int64_t(std::max({v[0], v[1], v[2]})) - std::min({v[0], v[1], v[2]});
+    };
+    rec->small = extent(tri.vx) <= detail::kSmallTriangleFx8 &&
+                 extent(tri.vy) <= detail::kSmallTriangleFx8;
+    std::memcpy(static_cast<void*>(&rec->interp()), &tri.interp, detail::interpolants_bytes(0));
+  }
+};
+
+// Compares the kernels of every level with the edge-equation rasterizer on every tile the
+// triangle touches; returns false (with failures recorded) on a difference.
+bool agrees(const detail::WindowVertex v[3], int width, int height) {
+  PixelRect scissor{0, 0, width, height};
+  detail::TriangleSetup tri;
+  if (!detail::setup_triangle(v[0], v[1], v[2], 0, CullMode::kNone, FrontFace::kCounterClockwise,
+                              scissor, tri)) {
+    return true;
+  }
+  OneRecord record(tri);
+  uint32_t offset = 0;
+  for (int level = 0; level <= int(cpu_simd_level()); ++level) {
+    detail::TileKernels kernels = detail::tile_kernels(SimdLevel(level));
+    for (int ty = tri.bounds.y0 / 64; ty <= (tri.bounds.y1 - 1) / 64; ++ty) {
+      for (int tx = tri.bounds.x0 / 64; tx <= (tri.bounds.x1 - 1) / 64; ++tx) {
+        PixelRect region = detail::intersect({tx * 64, ty * 64, tx * 64 + 64, ty * 64 + 64}, scissor);
+        Blocks expected, got;
+        detail::rasterize_triangle_edge_equations(tri, region, {&collect, &expected});
+        detail::FragmentProgram program{&record_block, &got};
+        detail::ShadeTarget target;
+        detail::TileJob job;
+        job.region = region;
+        job.program = &program;
+        job.target = &target;
+        kernels.immediate(job, record.bytes, &offset, 1);
+        if (got != expected) {
+          ADD_FAILURE() << "level " << simd_level_name(SimdLevel(level)) << " tile " << tx << ","
+                        << ty << " small " << reinterpret_cast<detail::TriRecord*>(record.bytes)->small
+                        << " vertices (" << v[0].x << "," << v[0].y << ") (" << v[1].x << ","
+                        << v[1].y << ") (" << v[2].x << "," << v[2].y << ")";
+          return false;
+        }
+      }
+    }
+  }
+  return true;
+}
+
+detail::WindowVertex vertex(int64_t x, int64_t y) {
+  detail::WindowVertex w;
+  w.x = int32_t(x);
+  w.y = int32_t(y);
+  return w;
+}
+
+TEST(TileKernel, CoverageEqualsTheEdgeEquationRasterizer) {
+  std::mt19937 rng(1234);
+  const int width = 300, height = 200;  // cut tiles on the right and at the bottom
+  // Triangle sizes in 1/256 pixel: inside one block, around the 32-bit bound, large, huge (far
+  // outside the image, inside the guard band).
+  const int64_t sizes[] = {700,
+                           3000,
+                           detail::kSmallTriangleFx8 - 50,
+                           detail::kSmallTriangleFx8 + 50,
+                           80 * 256,
+                           400 * 256,
+                           20000 * 256};
+  for (int64_t size : sizes) {
+    std::uniform_int_distribution<int64_t> centre_x(-20 * 256, (width + 20) * 256),
+        centre_y(-20 * 256, (height + 20) * 256), offset(-size / 2, size / 2);
+    for (int i = 0; i < 400; ++i) {
+      int64_t cx = centre_x(rng), cy = centre_y(rng);
+      detail::WindowVertex v[3];
+      for (auto& w : v) w = vertex(cx + offset(rng), cy + offset(rng));
+      if (i % 4 == 0) v[1].y = v[0].y;  // horizontal edges: the fill rule's ties
+      if (i % 5 == 0) v[2].x = v[1].x;  // vertical edges
+      if (i % 7 == 0) {                 // vertices on sample points
+        for (auto& w : v) w.x = (w.x & ~255) + 128, w.y = (w.y & ~255) + 128;
+      }
+      ASSERT_TRUE(agrees(v, width, height)) << "size " << size << " triangle " << i;
+    }
+  }
+}
+
+// The resolve kernels' depth is the fragment stage's (shade_block.hpp) to the bit, including
+// the clamp of values outside [0, 1], NaN and large gradients, and the test is LESS or LEQUAL.
+TEST(TileKernel, ResolveComputesTheFragmentStagesDepth) {
+  std::mt19937 rng(99);
+  std::uniform_real_distribution<float> value(-2.0f, 3.0f), gradient(-0.3f, 0.3f),
+      ref(-100.0f, 400.0f);
+  for (int level = 0; level <= int(cpu_simd_level()); ++level) {
+    detail::ResolveBlockFn resolve = detail::tile_kernels(SimdLevel(level)).resolve_block;
+    for (int i = 0; i < 2000; ++i) {
+      detail::DepthPlaneRef p{ref(rng), ref(rng), {value(rng), gradient(rng), gradient(rng)}};
+      if (i % 10 == 0) p.z.a0 = std::numeric_limits<float>::quiet_NaN();
+      if (i % 10 == 1) p.z.dadx = 1e30f;
+      if (i % 10 == 2) p.z = {0.5f, 0.0f, 0.0f};  // ties with the stored 0.5 below
+      int x = 4 * int(rng() % 4000), y = 4 * int(rng() % 4000);
+      uint32_t mask = rng() & 0xffffu;
+      bool less_equal = i % 2 == 0;
+      alignas(64) float depth[16];
+      alignas(64) int32_t ids[16];
+      for (int l = 0; l < 16; ++l) depth[l] = l % 3 == 0 ? 0.5f : value(rng), ids[l] = -1;
+      float expected_depth[16];
+      int32_t expected_ids[16];
+      for (int l = 0; l < 16; ++l) {
+        float dx = float(x + (l & 3)) + 0.5f - p.x_ref, dy = float(y + (l >> 2)) + 0.5f - p.y_ref;
+        float z = std::clamp(detail::eval_plane(p.z, dx, dy), 0.0f, 1.0f);
+        bool pass = (mask >> l & 1) &&
+                    detail::depth_passes(less_equal ? DepthFunc::kLessEqual : DepthFunc::kLess, z,
+                                         depth[l]);
+        expected_depth[l] = pass ? z : depth[l];
+        expected_ids[l] = pass ? 7 : -1;
+      }
+      resolve(p, x, y, mask, 7, less_equal, depth, ids);
+      ASSERT_EQ(std::memcmp(depth, expected_depth, sizeof(depth)), 0)
+          << simd_level_name(SimdLevel(level)) << " case " << i;
+      ASSERT_EQ(std::memcmp(ids, expected_ids, sizeof(ids)), 0)
+          << simd_level_name(SimdLevel(level)) << " case " << i;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace softrast
