@@ -4,9 +4,13 @@
 // temporary one).
 #ifdef SOFTRAST_CLI_PATH
 
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -15,6 +19,7 @@
 #include <ostream>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -347,6 +352,58 @@ TEST_F(CliTest, FailureLeavesAnExistingOutputAlone) {
 // ---------------------------------------------------------------------------------------------
 // Bad input: one error line, non-zero exit, no file written.
 
+// Starts `softrast ARGS` in the work folder with SOFTRAST_TEST_SLOW_WRITE_MS set (the write
+// sleeps after each 64 KiB), output to /dev/null; returns its pid.
+pid_t start_slow_writer(const fs::path& dir, const std::vector<std::string>& args) {
+  std::vector<std::string> env_text = {"SOFTRAST_TEST_SLOW_WRITE_MS=100"};
+  for (char** e = environ; *e; ++e) env_text.emplace_back(*e);
+  std::vector<char*> env, argv = {const_cast<char*>(SOFTRAST_CLI_PATH)};
+  for (std::string& e : env_text) env.push_back(e.data());
+  env.push_back(nullptr);
+  std::vector<std::string> arg_text = args;
+  for (std::string& a : arg_text) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = fork();
+  if (pid == 0) {  // only async-signal-safe calls until exec
+    int null = open("/dev/null", O_RDWR);
+    if (chdir(dir.c_str()) != 0 || null < 0) _exit(127);
+    for (int fd = 0; fd < 3; ++fd) dup2(null, fd);
+    execve(argv[0], argv.data(), env.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+bool has_temporary(const fs::path& dir) {
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.path().filename().string().find(".tmp.") != std::string::npos) return true;
+  }
+  return false;
+}
+
+// Interrupted while writing its image (the temporary file exists), the program removes the
+// temporary and dies of the signal: no output, no *.tmp.* file, and a shell sees 130 or 143.
+TEST_F(CliTest, SignalWhileWritingLeavesNoTemporaryFile) {
+  for (int signal : {SIGINT, SIGTERM}) {
+    SCOPED_TRACE(signal);
+    // A 512x512 TGA is 1 MiB, 16 chunks: 1.6 s of writing.
+    pid_t pid = start_slow_writer(work_dir(), {"--size", "512x512", "-q", "-o", "out.tga"});
+    ASSERT_GT(pid, 0);
+    auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!has_temporary(work_dir()) && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    bool writing = has_temporary(work_dir());
+    kill(pid, signal);
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(writing) << "the program never started writing";
+    ASSERT_TRUE(WIFSIGNALED(status)) << "exit status " << status;
+    EXPECT_EQ(WTERMSIG(status), signal);
+    EXPECT_EQ(files(), kFixtures);  // neither out.tga nor out.tga.tmp.<pid>.0
+  }
+}
+
 struct BadInput {
   const char* name;
   const char* args;
@@ -360,6 +417,8 @@ const BadInput kBadInputs[] = {
     {"MissingModel", "missing.obj -o out.png"},
     {"EmptyObj", "empty.obj -o out.png"},
     {"FaceIndexOutOfRange", "bad_index.obj -o out.png"},
+    {"ModelIsDevZero", "/dev/zero -o out.png"},
+    {"ModelIsAFolder", ". -o out.png"},
     {"GarbageTexture", "quad.obj --texture garbage.png -o out.png"},
     {"MissingTexture", "quad.obj --texture missing.png -o out.png"},
     {"TextureIsAnObj", "--texture quad.obj -o out.png"},

@@ -1,20 +1,25 @@
 // tests/io_test.cpp: image files, textures and samplers, and the OBJ/MTL loader.
 // Every test writes into its own fresh folder under the system's temporary directory.
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
+#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
 
+#include "io/obj_loader.hpp"
 #include "softrast/image.hpp"
 #include "softrast/mesh.hpp"
 #include "softrast/texture.hpp"
@@ -463,8 +468,10 @@ TEST_F(IoTest, ObjErrors) {
       {"neg.obj", std::string(kQuadPositions) + "f 1 2 -5\n", "out of range"},
       {"uv.obj", std::string(kQuadPositions) + "vt 0 0\nf 1/1 2/2 3/1\n", "out of range"},
       {"vn.obj", std::string(kQuadPositions) + "f 1//1 2//1 3//1\n", "out of range"},
-      {"zero.obj", std::string(kQuadPositions) + "f 0 1 2\n", "line"},
+      {"zero.obj", std::string(kQuadPositions) + "f 0 1 2\n", "face index 0 is out of range"},
       {"inf.obj", "v 1e999 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "not finite"},
+      {"line.obj", std::string(kQuadPositions) + "f 1 2\n", "fewer than 3"},
+      {"corner.obj", std::string(kQuadPositions) + "f 1 2 3/\n", "bad face corner '3/'"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
@@ -472,10 +479,154 @@ TEST_F(IoTest, ObjErrors) {
     Result<Mesh> mesh = load_obj(path(c.name));
     ASSERT_FALSE(mesh.ok());
     const std::string& message = mesh.status().message();
-    EXPECT_EQ(message.rfind(path(c.name) + ": ", 0), 0u) << message;
+    EXPECT_EQ(message.rfind(path(c.name) + ":", 0), 0u) << message;
     EXPECT_NE(message.find(c.message_part), std::string::npos) << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   }
+}
+
+// Indices tinyobj read with atoi: past 2^31 they wrapped (4294967299 became 3) or saturated
+// (99999999999999999999 became the last vertex), silently. Each is now an error naming the
+// file, the line and the valid range.
+TEST_F(IoTest, ObjIndicesThatOverflowOrAreZeroAreErrorsWithTheLine) {
+  struct Case {
+    const char* face;
+    const char* message;  // after "x.obj:5: "
+  };
+  const Case cases[] = {
+      {"f 1 2 99999999999999999999",
+       "face index 99999999999999999999 is out of range (1..3 or -3..-1)"},
+      {"f 1 2 4294967299", "face index 4294967299 is out of range (1..3 or -3..-1)"},
+      {"f 1 2 2147483648", "face index 2147483648 is out of range (1..3 or -3..-1)"},
+      {"f 1 2 -99999999999999999999",
+       "face index -99999999999999999999 is out of range (1..3 or -3..-1)"},
+      {"f 1 2 -4294967295", "face index -4294967295 is out of range (1..3 or -3..-1)"},
+      {"f 1 2 0", "face index 0 is out of range (1..3 or -3..-1)"},
+      {"f 1/4294967297 2/1 3/1",
+       "texture coordinate index 4294967297 is out of range (1..1 or -1..-1)"},
+      {"f 1//1 2//1 3//-2", "normal index -2 is out of range (1..1 or -1..-1)"},
+      {"f 1 2 3/1",
+       "texture coordinate index 1 is out of range (there are no texture coordinates)"},
+      {"f 1 2 3e0", "bad face corner: '3e0' is not an index"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.face);
+    std::string uv = std::string(c.face).find("/4294967297") != std::string::npos ? "vt 0 0\n" : "";
+    std::string normal = std::string(c.face).find("//") != std::string::npos ? "vn 0 0 1\n" : "";
+    std::string extra = uv + normal;
+    write("x.obj",
+          "v 0 0 0\nv 1 0 0\nv 0 1 0\n" + (extra.empty() ? "# none\n" : extra) + c.face + "\n");
+    Result<Mesh> mesh = load_obj(path("x.obj"));
+    ASSERT_FALSE(mesh.ok());
+    EXPECT_EQ(mesh.status().message(), path("x.obj") + ":5: " + c.message);
+  }
+}
+
+TEST_F(IoTest, ObjPositiveIndicesMayReferToLaterVerticesButAreCheckedAtTheEnd) {
+  write("later.obj", "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n");
+  Result<Mesh> mesh = load_obj(path("later.obj"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  EXPECT_EQ(mesh->positions[2], glm::vec3(0, 1, 0));
+  write("later.obj", "f 1 2 3\nf 1 2 7\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+  mesh = load_obj(path("later.obj"));
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(),
+            path("later.obj") + ":2: face index 7 is out of range (1..3 or -3..-1)");
+}
+
+// Numbers tinyobj's parser had undefined behaviour on: an exponent past 2^31 overflowed an int,
+// and `vw` (its skin weights) cast a float of 1e39 to int. Run under UBSan by the debug preset.
+TEST_F(IoTest, ObjNumbersTinyobjOverflowedOnAreErrorsOrSkipped) {
+  write("e.obj", "v 1e2147483648 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  Result<Mesh> mesh = load_obj(path("e.obj"));
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(),
+            path("e.obj") + ":1: number 1e2147483648 is not finite as a 32-bit float");
+  write("e.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n");
+  mesh = load_obj(path("e.obj"));
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(),
+            path("e.obj") + ":2: number 1e39 is not finite as a 32-bit float");
+  write("e.obj", "v 0 0 x\n");
+  mesh = load_obj(path("e.obj"));
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(), path("e.obj") + ":1: 'x' is not a number");
+  // Statements softrast does not use are skipped unread, whatever their numbers.
+  write("e.obj", std::string(kQuadPositions) + "vw 0 1e39 0.5\nl 1 99999999999999999999\n" +
+                     "vp 1e2147483648\nf 1 2 3 # a comment\n");
+  mesh = load_obj(path("e.obj"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  EXPECT_EQ(mesh->triangle_count(), 1u);
+  // MTL numbers go to tinyobj, so those it would overflow on are refused first.
+  write("e.mtl", "newmtl a\nKd 1e2147483648 0 0\n");
+  write("e.obj", std::string("mtllib e.mtl\n") + kQuadPositions + "usemtl a\nf 1 2 3\n");
+  mesh = load_obj(path("e.obj"));
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(), path("e.mtl") + ":2: number 1e2147483648 is out of range");
+  write("e.mtl", "newmtl a\nKd 1 1e39 0\n");  // tinyobj would cast it to a float
+  mesh = load_obj(path("e.obj"));
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(), path("e.mtl") + ":2: number 1e39 is out of range");
+}
+
+TEST_F(IoTest, ObjDevZeroFailsAtOnce) {
+  auto start = std::chrono::steady_clock::now();
+  Result<Mesh> mesh = load_obj("/dev/zero");
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(), "/dev/zero:1: NUL byte: not a text file");
+  EXPECT_LT(seconds, 1.0);
+  write("nul.obj", std::string(kQuadPositions) + "f 1 2 3\n" + std::string(1, '\0'));
+  mesh = load_obj(path("nul.obj"));
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(), path("nul.obj") + ":6: NUL byte: not a text file");
+}
+
+TEST_F(IoTest, ObjOverTheByteLimitIsRefusedBeforeReading) {
+  // A sparse file one byte over 2 GiB: refused from its size, so this takes no time or space.
+  write("huge.obj", "");
+  fs::resize_file(path("huge.obj"), uintmax_t(kMaxObjFileBytes) + 1);
+  Result<Mesh> mesh = load_obj(path("huge.obj"));
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(),
+            path("huge.obj") + ": file is larger than 2 GiB, the limit for OBJ files");
+  // The same with lowered limits through the internal entry point, for the OBJ and its MTL.
+  write("q.mtl", "newmtl a\nKd 1 1 1\n");
+  write("q.obj", std::string("mtllib q.mtl\n") + kQuadPositions + "usemtl a\nf 1 2 3\n");
+  int64_t size = int64_t(fs::file_size(path("q.obj")));
+  EXPECT_TRUE(detail::load_obj(path("q.obj"), size, 18).ok());
+  mesh = detail::load_obj(path("q.obj"), size - 1, 18);
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(), path("q.obj") + ": file is larger than " +
+                                         std::to_string(size - 1) +
+                                         " bytes, the limit for OBJ files");
+  mesh = detail::load_obj(path("q.obj"), size, 17);
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(),
+            path("q.mtl") + ": file is larger than 17 bytes, the limit for MTL files");
+}
+
+// A pipe has no size to check first: the limit is enforced while reading.
+TEST_F(IoTest, ObjFromAPipeIsCutOffAtTheByteLimit) {
+  ASSERT_EQ(::mkfifo(path("pipe.obj").c_str(), 0600), 0);
+  // One write of under PIPE_BUF bytes is atomic, so it is complete before the loader reads it
+  // and the writer never sees the reader close early.
+  std::string text = std::string(kQuadPositions) + "f 1 2 3\n";
+  for (int i = 0; i < 40; ++i) text += "# padding\n";
+  ASSERT_LT(text.size(), size_t(PIPE_BUF));
+  std::thread writer([&] { std::ofstream(path("pipe.obj"), std::ios::binary) << text; });
+  Result<Mesh> mesh = detail::load_obj(path("pipe.obj"), 100, kMaxMtlFileBytes);
+  writer.join();
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(),
+            path("pipe.obj") + ": file is larger than 100 bytes, the limit for OBJ files");
+}
+
+TEST_F(IoTest, ObjLineLongerThanOneMebibyteIsAnError) {
+  write("long.obj", std::string(kQuadPositions) + "# " + std::string(size_t(1) << 20, 'x'));
+  Result<Mesh> mesh = load_obj(path("long.obj"));
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(), path("long.obj") + ":5: line longer than 1 MiB");
 }
 
 TEST_F(IoTest, ObjMissingFileIsAnError) {

@@ -1,7 +1,10 @@
 // apps/softrast/main.cpp: the softrast command line. The only place that prints errors and
-// chooses exit codes: 0 success, 1 runtime error (files, memory), 2 usage error (flags).
+// chooses exit codes: 0 success, 1 runtime error (files, memory), 2 usage error (flags); SIGINT
+// and SIGTERM still end it as signals, after removing any temporary image file.
 //
 //   softrast [render] [MODEL] [-o out.png] [flags]     see `softrast --help`
+
+#include <signal.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -15,6 +18,7 @@
 #include "args.hpp"
 #include "run.hpp"
 #include "setup.hpp"
+#include "softrast/image.hpp"
 
 namespace {
 
@@ -56,6 +60,23 @@ void describe(CLI::App& app, CLI::App& render) {
       "  softrast render scene.obj --frames 10    # one JSON line of timings");
 }
 
+// SIGINT or SIGTERM: remove the temporary file of an image being written, then die of the signal
+// (SA_RESETHAND has restored the default action; the raised signal is delivered when the handler
+// returns), so the exit status still says which signal ended the program. Async-signal-safe.
+void on_terminating_signal(int signal) {
+  remove_pending_temporary_file();
+  raise(signal);
+}
+
+void install_signal_handlers() {
+  struct sigaction action {};
+  action.sa_handler = on_terminating_signal;
+  action.sa_flags = SA_RESETHAND;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
 // Parses and checks everything, then loads, renders and writes.
 int render_command(const RawArgs& raw) {
   Result<JobSpec> spec = interpret(raw);
@@ -95,6 +116,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  install_signal_handlers();
   try {
     return run(argc, argv);
   } catch (const std::bad_alloc&) {

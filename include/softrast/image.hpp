@@ -54,4 +54,10 @@ Result<Image> decode_image(const uint8_t* data, size_t size, const std::string& 
 // that is renamed over `path` only after a successful write.
 Status save_image(const std::string& path, const Image& image);
 
+// Removes the temporary file of a save_image in progress, if there is one. Async-signal-safe (it
+// reads a fixed buffer and calls unlink), for the SIGINT/SIGTERM handler of a program that then
+// exits: interrupted while writing, it leaves neither its output nor a `*.tmp.*` file behind.
+// Covers one save_image at a time (with several threads saving at once, the first).
+void remove_pending_temporary_file() noexcept;
+
 }  // namespace softrast

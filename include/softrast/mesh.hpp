@@ -42,9 +42,22 @@ struct Mesh {
   size_t triangle_count() const { return indices.size() / 3; }
 };
 
-// Loads a Wavefront OBJ (polygons fan-triangulated) with its MTL library (Kd and map_Kd at
-// least). Texture paths are relative to the MTL file. Errors name the file and, where it helps,
-// the line: missing file, no faces, index out of range, unreadable texture.
+// Largest OBJ file load_obj reads: 2 GiB, some 250 million triangles written tersely, whose mesh
+// (12 bytes of indices per triangle) is already more than most machines will render.
+inline constexpr int64_t kMaxObjFileBytes = int64_t(2) << 30;
+
+// Largest MTL file load_obj reads: 64 MiB, far beyond any real material library.
+inline constexpr int64_t kMaxMtlFileBytes = int64_t(64) << 20;
+
+// Loads a Wavefront OBJ (polygons fan-triangulated) with its MTL libraries (Kd and map_Kd at
+// least); v, vt, vn, f, usemtl and mtllib are read, other statements skipped. Texture paths are
+// relative to the MTL file, MTL paths to the OBJ; a missing MTL leaves its materials undefined
+// (their faces get the default material). Errors name the file and, where there is one, the line
+// ("model.obj:12: face index 99999999999999999999 is out of range (1..3 or -3..-1)"): missing or
+// unreadable file, a folder, more than kMaxObjFileBytes (kMaxMtlFileBytes for an MTL; a pipe or
+// device is cut off there), a NUL byte (not a text file), a line over 1 MiB, a number that is not
+// one or not finite as a float, a face with fewer than 3 corners or an index that is zero, out
+// of range or overflowing, no faces, an unreadable texture.
 Result<Mesh> load_obj(const std::string& path);
 
 // Fills `mesh.normals` with area-weighted smooth normals per position (used when the file has

@@ -9,11 +9,14 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <stb_image_write.h>
@@ -132,6 +135,58 @@ std::string temporary_name(const std::string& path) {
   return path + ".tmp." + std::to_string(getpid()) + "." + std::to_string(counter++);
 }
 
+// The temporary file being written, for remove_pending_temporary_file() in a signal handler: a
+// fixed buffer, so the handler neither allocates nor locks, claimed by one save_image at a time.
+// `pending_ready` is set only while the buffer holds a whole path; lock-free atomics are
+// async-signal-safe.
+char pending_path[4096];
+std::atomic<bool> pending_claimed{false};
+std::atomic<bool> pending_ready{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
+
+// Publishes `path` for the signal handler while it lives. The path is published before the file
+// is created and withdrawn after it is renamed or removed, so a signal in between unlinks at worst
+// a name that no longer exists (the pid in it makes it no other process's file). A path too long
+// for the buffer, or a second concurrent save, is simply not covered.
+class PendingTemporary {
+ public:
+  explicit PendingTemporary(const std::string& path) {
+    if (path.size() >= sizeof pending_path || pending_claimed.exchange(true)) return;
+    std::memcpy(pending_path, path.c_str(), path.size() + 1);
+    pending_ready.store(true);
+    owner_ = true;
+  }
+  ~PendingTemporary() {
+    if (!owner_) return;
+    pending_ready.store(false);
+    pending_claimed.store(false);
+  }
+  PendingTemporary(const PendingTemporary&) = delete;
+  PendingTemporary& operator=(const PendingTemporary&) = delete;
+
+ private:
+  bool owner_ = false;
+};
+
+constexpr size_t kWriteChunk = size_t(1) << 16;
+
+// Test hook: SOFTRAST_TEST_SLOW_WRITE_MS=N sleeps N ms after each 64 KiB written, so that a test
+// can interrupt the program while the temporary file exists (tests/cli_test.cpp). Not for users.
+std::chrono::milliseconds write_delay() {
+  const char* text = std::getenv("SOFTRAST_TEST_SLOW_WRITE_MS");
+  return std::chrono::milliseconds(text ? std::clamp(std::atoll(text), 0LL, 10000LL) : 0);
+}
+
+bool write_chunks(std::FILE* f, const std::vector<uint8_t>& bytes) {
+  std::chrono::milliseconds delay = write_delay();
+  for (size_t at = 0; at < bytes.size(); at += kWriteChunk) {
+    size_t n = std::min(kWriteChunk, bytes.size() - at);
+    if (std::fwrite(bytes.data() + at, 1, n, f) != n) return false;
+    if (delay.count() > 0) std::this_thread::sleep_for(delay);
+  }
+  return true;
+}
+
 // Writes all of `bytes` to a new file, flushed to the disk before it is closed; on failure removes
 // it and says why. "x" refuses an existing file, so a stale temporary is never reused.
 bool write_new_file(const std::string& path, const std::vector<uint8_t>& bytes,
@@ -141,7 +196,7 @@ bool write_new_file(const std::string& path, const std::vector<uint8_t>& bytes,
     reason = errno_text();
     return false;
   }
-  bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+  bool ok = write_chunks(f, bytes);
   ok = ok && std::fflush(f) == 0 && fsync(fileno(f)) == 0;
   if (!ok) reason = errno_text();
   if (std::fclose(f) != 0 && ok) {
@@ -201,6 +256,7 @@ Status save_image(const std::string& path, const Image& image) {
   std::vector<uint8_t> bytes;
   if (!encode(format, image, bytes)) return fail(path, "cannot encode image");
   std::string temporary = temporary_name(path);
+  PendingTemporary pending(temporary);
   if (std::string reason; !write_new_file(temporary, bytes, reason)) {
     return fail(path, "cannot write: " + reason);
   }
@@ -210,6 +266,10 @@ Status save_image(const std::string& path, const Image& image) {
     return fail(path, "cannot replace file: " + reason);
   }
   return {};
+}
+
+void remove_pending_temporary_file() noexcept {
+  if (pending_ready.load()) unlink(pending_path);
 }
 
 }  // namespace softrast

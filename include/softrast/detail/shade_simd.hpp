@@ -106,15 +106,21 @@ SOFTRAST_SIMD_INLINE simd::Int<N> depth_passes(DepthFunc f, const simd::Float<N>
   return simd::Int<N>(0);
 }
 
+// A named always-inline function, not a lambda: a lambda is not inlined at -O0, and compiled on
+// its own (without the caller's AVX-512 target) it mishandled Float<16> and crashed the debug
+// preset's tests.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Int<N> pack_channel(const simd::Float<N>& v) {
+  using F = simd::Float<N>;
+  F clamped = simd::min(simd::max(v, F(0.0f)), F(1.0f));
+  return simd::to_int(clamped * F(255.0f) + F(0.5f));
+}
+
 // pack_rgba8 for 16 lanes: clamp to [0, 1] (NaN to 0), x * 255 + 0.5 truncated, R in the low byte.
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Int<N> pack_rgba8(const simd::Vec4<N>& c) {
-  using F = simd::Float<N>;
-  auto channel = [](const F& v) {
-    F clamped = simd::min(simd::max(v, F(0.0f)), F(1.0f));
-    return simd::to_int(clamped * F(255.0f) + F(0.5f));
-  };
-  return channel(c.x) | channel(c.y) << 8 | channel(c.z) << 16 | channel(c.w) << 24;
+  return pack_channel(c.x) | pack_channel(c.y) << 8 | pack_channel(c.z) << 16 |
+         pack_channel(c.w) << 24;
 }
 
 template <int N>

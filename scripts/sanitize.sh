@@ -1,0 +1,30 @@
+#!/bin/sh
+# Runs the whole test suite under AddressSanitizer + UBSan (the debug preset, build/debug), then the
+# threaded tests (names containing Thread or Deferred) under ThreadSanitizer in build/tsan. Any
+# sanitizer report fails the run: UBSan halts on its first error instead of printing and going on.
+#
+#   scripts/sanitize.sh            # from the source folder; NICE=0 to run without nice -n 19
+set -eu
+
+cd "$(dirname "$0")/.."
+nice="nice -n ${NICE:-19}"
+
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+export ASAN_OPTIONS="detect_leaks=1"
+export TSAN_OPTIONS="halt_on_error=1"
+
+echo "== AddressSanitizer + UBSan: every test (build/debug)"
+$nice cmake --preset debug
+$nice cmake --build --preset debug
+$nice ctest --preset debug
+
+# TSan cannot be combined with ASan, hence a build of its own. Only the test binary is needed;
+# the reference renderer and the benchmarks are left out.
+echo "== ThreadSanitizer: tests matching Thread or Deferred (build/tsan)"
+$nice cmake -S . -B build/tsan -DCMAKE_BUILD_TYPE=Debug \
+  -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
+  -DSOFTRAST_BUILD_REFERENCE=OFF -DSOFTRAST_BUILD_BENCHMARKS=OFF -DSOFTRAST_BUILD_EXAMPLES=OFF
+$nice cmake --build build/tsan --target softrast_tests -j 2
+$nice build/tsan/tests/softrast_tests --gtest_filter='*Thread*:*Deferred*'
+
+echo "sanitize.sh: all passed"
