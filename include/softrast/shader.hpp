@@ -65,11 +65,15 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
           std::span<const uint32_t> indices, uint32_t vertex_count) {
   constexpr int kStride = 4 + S::kVaryings;
   constexpr uint32_t kVerticesPerJob = 4096;
-  std::vector<float> clip(size_t(vertex_count) * kStride);
+  // The vertex stage's output, kept per thread and per shader type between draws: a scene drawn
+  // again allocates nothing (the vector only grows; every element used is written below).
+  thread_local std::vector<float> clip;
+  if (clip.size() < size_t(vertex_count) * kStride) clip.resize(size_t(vertex_count) * kStride);
+  float* const out = clip.data();  // the calling thread's buffer (workers have their own)
   auto shade_vertices = [&](size_t job) {
     uint32_t end = uint32_t(std::min<size_t>(vertex_count, (job + 1) * kVerticesPerJob));
     for (uint32_t i = uint32_t(job * kVerticesPerJob); i < end; ++i) {
-      float* v = &clip[size_t(i) * kStride];
+      float* v = out + size_t(i) * kStride;
       glm::vec4 p = shader.vertex(i, v + 4);
       v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = p.w;
     }
@@ -77,7 +81,7 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
   size_t jobs = (size_t(vertex_count) + kVerticesPerJob - 1) / kVerticesPerJob;
   detail::parallel_for(jobs, state.threads > 0 ? state.threads : detail::hardware_threads(),
                        shade_vertices);
-  detail::ClipVertices vertices{clip.data(), vertex_count, kStride, S::kVaryings};
+  detail::ClipVertices vertices{out, vertex_count, kStride, S::kVaryings};
   detail::FragmentProgram program;
   program.shader = &shader;
   if constexpr (detail::WideShader<S>) {
