@@ -268,6 +268,38 @@ TEST_F(CliTest, UnsupportedTextureFormatIsOneErrorLine) {
   EXPECT_EQ(files(), fixtures_and({"deep.pgm"}));
 }
 
+// The wireframe overlay over a floor seen from above (the framing of flat models): the shared
+// diagonal has a wire pixel in every column it crosses. With a constant depth bias instead of a
+// slope-scaled polygon offset it came out dotted (every other pixel hidden by its own surface).
+TEST_F(CliTest, WireframeOverlayDiagonalIsSolid) {
+  write("floor.obj", "v -1 -1 -1\nv 1 -1 -1\nv 1 -1 1\nv -1 -1 1\nf 3 2 1\nf 4 3 1\n");
+  CliRun r = run("floor.obj --wireframe --shader flat --size 400x300 -o wire.png");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  Image image = load("wire.png", 400, 300);
+  int wire = to_unorm8(0.05f);
+  auto is_wire = [&](int x, int y) { return pixel(image, x, y)[0] == wire; };
+  auto is_surface = [&](int x, int y) { return pixel(image, x, y)[0] == to_unorm8(0.9f); };
+  // The floor's columns, and in the middle 60 % of them (away from the corners the diagonal
+  // ends in) a wire pixel with the surface three rows above and below.
+  int left = 400, right = -1;
+  for (int x = 0; x < 400; ++x) {
+    for (int y = 0; y < 300; ++y) {
+      if (is_surface(x, y)) left = std::min(left, x), right = std::max(right, x);
+    }
+  }
+  int columns = 0, with_wire = 0;
+  for (int x = left + (right - left) / 5; x <= right - (right - left) / 5; ++x) {
+    bool interior_wire = false;
+    for (int y = 3; y < 297; ++y) {
+      if (is_wire(x, y) && is_surface(x, y - 3) && is_surface(x, y + 3)) interior_wire = true;
+    }
+    ++columns;
+    with_wire += interior_wire;
+  }
+  ASSERT_GT(columns, 100);
+  EXPECT_EQ(with_wire, columns);
+}
+
 // Without --light the light follows the camera: (0.3, 0.5, 0.8) in the camera's frame (x right,
 // y up, z towards the viewer), so a surface facing the viewer is lit from any side.
 TEST_F(CliTest, DefaultLightIsAHeadlight) {
