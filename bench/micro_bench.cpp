@@ -52,8 +52,10 @@ Mesh sphere_grid(int columns, int rows, int slices, int stacks) {
 // The vertex stage: the built-in Gouraud vertex shader over a mesh's vertices.
 void BM_VertexShader(benchmark::State& state) {
   Mesh mesh = sphere_grid(16, 9, 32, 28);
-  detail::GouraudShader shader{{&mesh, glm::mat4(1.0f)}, glm::vec3(0.9f, 0.6f, 0.3f),
-                               glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f)), 1.0f};
+  detail::GouraudShader shader{{&mesh, glm::mat4(1.0f)},
+                               glm::vec3(0.9f, 0.6f, 0.3f),
+                               glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f)),
+                               1.0f};
   std::vector<float> out(mesh.positions.size() * 7);
   for (auto _ : state) {
     for (uint32_t i = 0; i < mesh.positions.size(); ++i) {
@@ -164,8 +166,8 @@ void BM_Shade(benchmark::State& state) {
   set_simd_level(SimdLevel::kAvx512);
 }
 void shade_args(benchmark::internal::Benchmark* b) {
-  for (ShaderKind k : {ShaderKind::kFlat, ShaderKind::kGouraud, ShaderKind::kTexture,
-                       ShaderKind::kPhong}) {
+  for (ShaderKind k :
+       {ShaderKind::kFlat, ShaderKind::kGouraud, ShaderKind::kTexture, ShaderKind::kPhong}) {
     for (int level = 0; level < 4; ++level) b->Args({int(k), level});
   }
 }
@@ -177,7 +179,8 @@ Mesh plane_grid(int columns, int rows, bool reversed) {
   Mesh mesh;
   for (int j = 0; j <= rows; ++j) {
     for (int i = 0; i <= columns; ++i) {
-      mesh.positions.push_back({(float(i) / columns - 0.5f) * 3.2f, (float(j) / rows - 0.5f) * 1.8f, 0});
+      mesh.positions.push_back(
+          {(float(i) / columns - 0.5f) * 3.2f, (float(j) / rows - 0.5f) * 1.8f, 0});
       mesh.normals.push_back({0, 0, 1});
       mesh.uvs.push_back({float(i) / columns, float(j) / rows});
     }

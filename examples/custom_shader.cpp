@@ -33,7 +33,8 @@ struct CheckerHole {
     using I = softrast::simd::Int<N>;
     F du = f.varying(0) - 0.5f, dv = f.varying(1) - 0.5f;
     f.discard(du * du + dv * dv < F(0.04f));  // a hole of radius 0.2
-    I cells = softrast::simd::to_int(f.varying(0) * 8.0f) + softrast::simd::to_int(f.varying(1) * 8.0f);
+    I cells =
+        softrast::simd::to_int(f.varying(0) * 8.0f) + softrast::simd::to_int(f.varying(1) * 8.0f);
     I odd = (cells & I(1)) == I(1);
     f.color = {select(odd, F(0.9f), F(0.2f)), select(odd, F(0.5f), F(0.3f)),
                select(odd, F(0.2f), F(0.5f)), F(1.0f)};

@@ -309,9 +309,9 @@ TEST_F(CliTest, DefaultLightIsAHeadlight) {
     glm::vec3 true_up = glm::cross(right, forward);
     glm::vec3 light = glm::normalize(0.3f * right + 0.5f * true_up - 0.8f * forward);
     float lit = 0.15f + 0.85f * std::max(light.z, 0.0f);  // the quad's normal is +z
-    std::string flags = "quad.obj --size 32x32 --shader gouraud --eye " +
-                        std::to_string(eye.x) + "," + std::to_string(eye.y) + "," +
-                        std::to_string(eye.z) + " --target 0,0,0 -o lit.png";
+    std::string flags = "quad.obj --size 32x32 --shader gouraud --eye " + std::to_string(eye.x) +
+                        "," + std::to_string(eye.y) + "," + std::to_string(eye.z) +
+                        " --target 0,0,0 -o lit.png";
     CliRun r = run(flags);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NEAR(pixel(load("lit.png", 32, 32), 16, 16)[0], to_unorm8(0.9f * lit), 1)
@@ -325,13 +325,12 @@ TEST_F(CliTest, HelpMentionsEveryFlag) {
     EXPECT_EQ(r.exit_code, 0) << args;
     EXPECT_EQ(r.err, "") << args;
     for (const char* flag :
-         {"--size",    "--eye",        "--target", "--up",        "--fov",     "--ortho",
-          "--near",    "--far",        "--shader", "--wireframe", "--texture", "--color",
-          "--cull",    "--front-face", "--depth",  "--blend",     "--alpha",   "--raster",
-          "--filter",  "--wrap",       "--frames", "--threads",   "--quiet",   "--help",
-          "--light",
-          "--version", "-o",           "MODEL",    "flat",        "gouraud",   "phong",
-          "normals",   "scanline",     "notequal", "mirror"}) {
+         {"--size",   "--eye",        "--target", "--up",        "--fov",     "--ortho",
+          "--near",   "--far",        "--shader", "--wireframe", "--texture", "--color",
+          "--cull",   "--front-face", "--depth",  "--blend",     "--alpha",   "--raster",
+          "--filter", "--wrap",       "--frames", "--threads",   "--quiet",   "--help",
+          "--light",  "--version",    "-o",       "MODEL",       "flat",      "gouraud",
+          "phong",    "normals",      "scanline", "notequal",    "mirror"}) {
       EXPECT_NE(r.out.find(flag), std::string::npos) << args << " does not mention " << flag;
     }
   }

@@ -65,8 +65,7 @@ void draw_deferrable(Framebuffer& fb, const RenderState& state, const S& shader,
     std::memcpy(&clip[size_t(i) * kStride], &p, sizeof(p));
   }
   detail::ClipVertices vertices{clip.data(), vertex_count, kStride, S::kVaryings};
-  detail::FragmentProgram program{&resolved_aware_shade_block<S>, &shader,
-                                  !detail::WritesDepth<S>};
+  detail::FragmentProgram program{&resolved_aware_shade_block<S>, &shader, !detail::WritesDepth<S>};
   detail::draw_clip_space(fb, state, vertices, indices.data(), indices.size(), program);
 }
 

@@ -92,12 +92,12 @@ TEST(Mipmap, TrilinearBlendsTheTwoLevelsAroundTheLevelOfDetail) {
     float step = std::exp2(lod) / 64.0f;
     return t.sample(s, white_centre, {step, 0.0f}, {0.0f, step}).r * 255.0f;
   };
-  EXPECT_NEAR(red(-1.0f), 255.0f, 1e-3f);          // magnified: the base level, bilinear
+  EXPECT_NEAR(red(-1.0f), 255.0f, 1e-3f);  // magnified: the base level, bilinear
   EXPECT_NEAR(red(0.0f), 255.0f, 1e-3f);
   EXPECT_NEAR(red(0.5f), 0.5f * 255.0f + 0.5f * 128.0f, 0.05f);
   EXPECT_NEAR(red(0.25f), 0.75f * 255.0f + 0.25f * 128.0f, 0.05f);
   EXPECT_NEAR(red(3.0f), 128.0f, 1e-3f);
-  EXPECT_NEAR(red(40.0f), 128.0f, 1e-3f);          // past the last level: the 1x1 level
+  EXPECT_NEAR(red(40.0f), 128.0f, 1e-3f);  // past the last level: the 1x1 level
   // Without derivatives, or with another filter, the base level is sampled.
   EXPECT_NEAR(t.sample(s, white_centre).r * 255.0f, 255.0f, 1e-3f);
 }

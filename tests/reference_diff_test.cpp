@@ -338,7 +338,8 @@ class ReferenceDiffTest : public testing::Test {
   Image run(const std::string& program, const std::string& args, const std::string& out) {
     std::string log = path(out + ".log");
     std::string command = "cd " + quote(dir_.string()) + " && " + quote(program) + " " + args +
-                          " --light 0.3,0.5,0.8 -q -o " + quote(out) + " >" + quote(log) + " 2>&1 </dev/null";
+                          " --light 0.3,0.5,0.8 -q -o " + quote(out) + " >" + quote(log) +
+                          " 2>&1 </dev/null";
     int status = std::system(command.c_str());
     bool ok = status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
     EXPECT_TRUE(ok) << program << " " << args << "\n" << read_text(log);

@@ -77,8 +77,7 @@ TEST_P(SimdLevelGolden, EveryLevelGivesTheSameCoverageAndColoursWithinOne) {
     }
     EXPECT_EQ(depth_differs, 0) << simd_level_name(level) << " vs "
                                 << simd_level_name(levels.back());
-    EXPECT_EQ(colour_out, 0) << simd_level_name(level) << " vs "
-                             << simd_level_name(levels.back());
+    EXPECT_EQ(colour_out, 0) << simd_level_name(level) << " vs " << simd_level_name(levels.back());
   }
 }
 
@@ -118,10 +117,10 @@ void expect_sampler_matches_scalar(const Texture& texture, const Sampler& sample
                             ? sample<N>(texture, sampler, uv, dx, dy)
                             : sample<N>(texture, sampler, uv);
     for (int i = 0; i < simd::kLanes; ++i) {
-      glm::vec4 want = sampler.filter == Filter::kTrilinear
-                           ? texture.sample(sampler, uvs[first + i], test_ddx(first + i),
-                                            test_ddy(first + i))
-                           : texture.sample(sampler, uvs[first + i]);
+      glm::vec4 want =
+          sampler.filter == Filter::kTrilinear
+              ? texture.sample(sampler, uvs[first + i], test_ddx(first + i), test_ddy(first + i))
+              : texture.sample(sampler, uvs[first + i]);
       ASSERT_EQ(got.x.lane(i), want.r) << "uv " << uvs[first + i].x << "," << uvs[first + i].y;
       ASSERT_EQ(got.y.lane(i), want.g);
       ASSERT_EQ(got.z.lane(i), want.b);
@@ -141,7 +140,7 @@ void check_sampler_at_native_width<4>(const Texture& t, const Sampler& s,
 }
 template <>
 [[gnu::target("avx2")]] void check_sampler_at_native_width<8>(const Texture& t, const Sampler& s,
-                                                               const std::vector<glm::vec2>& uvs) {
+                                                              const std::vector<glm::vec2>& uvs) {
   expect_sampler_matches_scalar<8>(t, s, uvs);
 }
 template <>

@@ -42,8 +42,8 @@ struct OneRecord {
     auto extent = [](const int32_t v[3]) {
       return int64_t(std::max({v[0], v[1], v[2]})) - std::min({v[0], v[1], v[2]});
     };
-    rec->small = extent(tri.vx) <= detail::kSmallTriangleFx8 &&
-                 extent(tri.vy) <= detail::kSmallTriangleFx8;
+    rec->small =
+        extent(tri.vx) <= detail::kSmallTriangleFx8 && extent(tri.vy) <= detail::kSmallTriangleFx8;
     std::memcpy(static_cast<void*>(&rec->interp()), &tri.interp, detail::interpolants_bytes(0));
   }
 };
@@ -63,7 +63,8 @@ bool agrees(const detail::WindowVertex v[3], int width, int height) {
     detail::TileKernels kernels = detail::tile_kernels(SimdLevel(level));
     for (int ty = tri.bounds.y0 / 64; ty <= (tri.bounds.y1 - 1) / 64; ++ty) {
       for (int tx = tri.bounds.x0 / 64; tx <= (tri.bounds.x1 - 1) / 64; ++tx) {
-        PixelRect region = detail::intersect({tx * 64, ty * 64, tx * 64 + 64, ty * 64 + 64}, scissor);
+        PixelRect region =
+            detail::intersect({tx * 64, ty * 64, tx * 64 + 64, ty * 64 + 64}, scissor);
         Blocks expected, got;
         detail::rasterize_triangle_edge_equations(tri, region, {&collect, &expected});
         detail::FragmentProgram program{&record_block, &got};
@@ -75,7 +76,8 @@ bool agrees(const detail::WindowVertex v[3], int width, int height) {
         kernels.immediate(job, record.bytes, &offset, 1);
         if (got != expected) {
           ADD_FAILURE() << "level " << simd_level_name(SimdLevel(level)) << " tile " << tx << ","
-                        << ty << " small " << reinterpret_cast<detail::TriRecord*>(record.bytes)->small
+                        << ty << " small "
+                        << reinterpret_cast<detail::TriRecord*>(record.bytes)->small
                         << " vertices (" << v[0].x << "," << v[0].y << ") (" << v[1].x << ","
                         << v[1].y << ") (" << v[2].x << "," << v[2].y << ")";
           return false;

@@ -25,16 +25,36 @@ std::vector<float> test_vertices(int count, unsigned seed) {
     float w = 0.1f + 3.0f * std::abs(unit(rng));
     float p[5] = {unit(rng) * 1.3f * w, unit(rng) * 1.3f * w, unit(rng) * 1.3f * w, w, unit(rng)};
     switch (i % 12) {
-      case 1: p[0] *= 3000.0f; break;             // beyond the guard band
-      case 2: p[3] = -p[3]; break;                // behind the eye
-      case 3: p[3] = 1e-7f; p[0] = p[1] = 0; break;  // below kMinClipW
-      case 4: p[2] = p[3]; break;                 // on the far plane
-      case 5: p[2] = -p[3]; break;                // on the near plane
-      case 6: p[i % 4] = (i % 24 < 12) ? nan : inf; break;
-      case 7: p[0] = 1e30f, p[3] = 1e30f; break;  // huge
-      case 8: p[1] = -inf; break;
-      case 9: p[0] = p[3] * 0.999f; break;        // near the image edge
-      default: break;
+      case 1:
+        p[0] *= 3000.0f;
+        break;  // beyond the guard band
+      case 2:
+        p[3] = -p[3];
+        break;  // behind the eye
+      case 3:
+        p[3] = 1e-7f;
+        p[0] = p[1] = 0;
+        break;  // below kMinClipW
+      case 4:
+        p[2] = p[3];
+        break;  // on the far plane
+      case 5:
+        p[2] = -p[3];
+        break;  // on the near plane
+      case 6:
+        p[i % 4] = (i % 24 < 12) ? nan : inf;
+        break;
+      case 7:
+        p[0] = 1e30f, p[3] = 1e30f;
+        break;  // huge
+      case 8:
+        p[1] = -inf;
+        break;
+      case 9:
+        p[0] = p[3] * 0.999f;
+        break;  // near the image edge
+      default:
+        break;
     }
     v.insert(v.end(), p, p + 5);
   }
@@ -64,8 +84,8 @@ TEST(VertexKernel, EqualsTheScalarFrontEnd) {
           detail::PackedVertex expected{w.x, w.y, w.z, w.inv_w};
           ASSERT_EQ(std::memcmp(&window[i], &expected, sizeof(expected)), 0)
               << simd_level_name(SimdLevel(level)) << " vertex " << i << " size " << size
-              << " bias " << bias << ": " << window[i].x << "," << window[i].y << ","
-              << window[i].z << " vs " << w.x << "," << w.y << "," << w.z;
+              << " bias " << bias << ": " << window[i].x << "," << window[i].y << "," << window[i].z
+              << " vs " << w.x << "," << w.y << "," << w.z;
         }
       }
     }

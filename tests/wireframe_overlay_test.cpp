@@ -12,7 +12,9 @@ constexpr uint32_t kWire = 0xff0000ffu;  // pure red, RGBA8 little-endian
 
 Mesh square(float size, float z, float tilt) {
   Mesh m;
-  m.positions = {{-size, -size, z - tilt}, {size, -size, z - tilt}, {size, size, z + tilt},
+  m.positions = {{-size, -size, z - tilt},
+                 {size, -size, z - tilt},
+                 {size, size, z + tilt},
                  {-size, size, z + tilt}};
   m.normals.assign(4, glm::vec3(0, 0, 1));
   m.uvs.assign(4, glm::vec2(0));

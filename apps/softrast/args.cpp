@@ -46,10 +46,12 @@ void define_shading_flags(CLI::App& app, RawArgs& a) {
   app.add_option("--color", a.color, "Albedo for flat, gouraud and phong (default 0.9,0.6,0.3)")
       ->type_name("R,G,B");
   app.add_option("--light", a.light,
-                 "Direction towards the light, fixed in world space (default: a headlight, 0.3,0.5,0.8 in the camera's frame, so any view is lit from its upper left)")
+                 "Direction towards the light, fixed in world space (default: a headlight, "
+                 "0.3,0.5,0.8 in the camera's frame, so any view is lit from its upper left)")
       ->type_name("X,Y,Z");
   app.add_option("--alpha", a.alpha, "Output alpha in [0, 1] (default 1)")->type_name("A");
-  app.add_option("--filter", a.filter, "Texture filter: nearest, bilinear or trilinear (mipmapped) (default bilinear)")
+  app.add_option("--filter", a.filter,
+                 "Texture filter: nearest, bilinear or trilinear (mipmapped) (default bilinear)")
       ->type_name("MODE");
   app.add_option("--wrap", a.wrap, "Texture wrap: repeat, clamp or mirror (default repeat)")
       ->type_name("MODE");

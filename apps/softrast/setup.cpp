@@ -76,8 +76,8 @@ constexpr std::array<Named<BlendMode>, 3> kBlendModes = {
 constexpr std::array<Named<RasterAlgorithm>, 2> kRasterAlgorithms = {
     {{"edge", RasterAlgorithm::kEdgeEquations}, {"scanline", RasterAlgorithm::kScanline}}};
 constexpr std::array<Named<Filter>, 3> kFilters = {{{"nearest", Filter::kNearest},
-                                                     {"bilinear", Filter::kBilinear},
-                                                     {"trilinear", Filter::kTrilinear}}};
+                                                    {"bilinear", Filter::kBilinear},
+                                                    {"trilinear", Filter::kTrilinear}}};
 constexpr std::array<Named<Wrap>, 3> kWraps = {
     {{"repeat", Wrap::kRepeat}, {"clamp", Wrap::kClampToEdge}, {"mirror", Wrap::kMirroredRepeat}}};
 constexpr std::array<ShaderKind, 7> kShaderKinds = {

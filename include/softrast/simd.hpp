@@ -95,22 +95,26 @@ struct Float {
   // (Typed unaligned vector accesses: GCC 12 splits a memcpy of the parts into 16-byte moves.)
   SOFTRAST_SIMD_INLINE static Float load(const float* lanes) {
     Float r;
-    for (int k = 0; k < kParts; ++k) r.p[k] = *reinterpret_cast<const typename Native<N>::FU*>(lanes + k * N);
+    for (int k = 0; k < kParts; ++k)
+      r.p[k] = *reinterpret_cast<const typename Native<N>::FU*>(lanes + k * N);
     return r;
   }
   SOFTRAST_SIMD_INLINE void store(float* lanes) const {
-    for (int k = 0; k < kParts; ++k) *reinterpret_cast<typename Native<N>::FU*>(lanes + k * N) = p[k];
+    for (int k = 0; k < kParts; ++k)
+      *reinterpret_cast<typename Native<N>::FU*>(lanes + k * N) = p[k];
   }
   SOFTRAST_SIMD_INLINE float lane(int i) const { return p[i / N][i % N]; }
   SOFTRAST_SIMD_INLINE void set_lane(int i, float v) { p[i / N][i % N] = v; }
 
-#define SOFTRAST_SIMD_FLOAT_OP(op)                                             \
+#define SOFTRAST_SIMD_FLOAT_OP(op)                                                \
   SOFTRAST_SIMD_INLINE friend Float operator op(const Float& a, const Float& b) { \
-    Float r;                                                                   \
-    for (int k = 0; k < kParts; ++k) r.p[k] = a.p[k] op b.p[k];                \
-    return r;                                                                  \
-  }                                                                            \
-  SOFTRAST_SIMD_INLINE Float& operator op##=(const Float & b) { return *this = *this op b; }
+    Float r;                                                                      \
+    for (int k = 0; k < kParts; ++k) r.p[k] = a.p[k] op b.p[k];                   \
+    return r;                                                                     \
+  }                                                                               \
+  SOFTRAST_SIMD_INLINE Float& operator op##=(const Float& b) {                    \
+    return *this = *this op b;                                                    \
+  }
   SOFTRAST_SIMD_FLOAT_OP(+)
   SOFTRAST_SIMD_FLOAT_OP(-)
   SOFTRAST_SIMD_FLOAT_OP(*)
@@ -158,15 +162,17 @@ struct Int {
   }
   SOFTRAST_SIMD_INLINE static Int load(const int32_t* lanes) {
     Int r;
-    for (int k = 0; k < kParts; ++k) r.p[k] = *reinterpret_cast<const typename Native<N>::IU*>(lanes + k * N);
+    for (int k = 0; k < kParts; ++k)
+      r.p[k] = *reinterpret_cast<const typename Native<N>::IU*>(lanes + k * N);
     return r;
   }
   SOFTRAST_SIMD_INLINE void store(int32_t* lanes) const {
-    for (int k = 0; k < kParts; ++k) *reinterpret_cast<typename Native<N>::IU*>(lanes + k * N) = p[k];
+    for (int k = 0; k < kParts; ++k)
+      *reinterpret_cast<typename Native<N>::IU*>(lanes + k * N) = p[k];
   }
   SOFTRAST_SIMD_INLINE int32_t lane(int i) const { return p[i / N][i % N]; }
 
-#define SOFTRAST_SIMD_INT_OP(op)                                              \
+#define SOFTRAST_SIMD_INT_OP(op)                                            \
   SOFTRAST_SIMD_INLINE friend Int operator op(const Int& a, const Int& b) { \
     Int r;                                                                  \
     for (int k = 0; k < kParts; ++k) r.p[k] = a.p[k] op b.p[k];             \
@@ -181,17 +187,17 @@ struct Int {
 #undef SOFTRAST_SIMD_INT_OP
   // Comparisons written as selects: GCC 12 keeps a vector condition whole, where it may split
   // a bare integer comparison into lanes.
-#define SOFTRAST_SIMD_INT_CMP(op, predicate)                                   \
-  SOFTRAST_SIMD_INLINE friend Int operator op(const Int& a, const Int& b) {    \
-    Int r;                                                                     \
-    for (int k = 0; k < kParts; ++k) {                                         \
-      if constexpr (N == 16) {                                                 \
-        isa::cmp(predicate, a.p[k], b.p[k], r.p[k]);                           \
-      } else {                                                                 \
-        r.p[k] = a.p[k] op b.p[k] ? ~V{} : V{};                                \
-      }                                                                        \
-    }                                                                          \
-    return r;                                                                  \
+#define SOFTRAST_SIMD_INT_CMP(op, predicate)                                \
+  SOFTRAST_SIMD_INLINE friend Int operator op(const Int& a, const Int& b) { \
+    Int r;                                                                  \
+    for (int k = 0; k < kParts; ++k) {                                      \
+      if constexpr (N == 16) {                                              \
+        isa::cmp(predicate, a.p[k], b.p[k], r.p[k]);                        \
+      } else {                                                              \
+        r.p[k] = a.p[k] op b.p[k] ? ~V{} : V{};                             \
+      }                                                                     \
+    }                                                                       \
+    return r;                                                               \
   }
   SOFTRAST_SIMD_INT_CMP(<, _MM_CMPINT_LT)
   SOFTRAST_SIMD_INT_CMP(>, _MM_CMPINT_NLE)
@@ -301,22 +307,42 @@ namespace isa {
 SOFTRAST_AVX512 void cmp(int predicate, const F16& a, const F16& b, I16& r) {
   __mmask16 m = 0;
   switch (predicate) {
-    case _CMP_LT_OQ: m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_LT_OQ); break;
-    case _CMP_LE_OQ: m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_LE_OQ); break;
-    case _CMP_GT_OQ: m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_GT_OQ); break;
-    case _CMP_GE_OQ: m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_GE_OQ); break;
-    case _CMP_EQ_OQ: m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_EQ_OQ); break;
-    default: m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_NEQ_UQ); break;
+    case _CMP_LT_OQ:
+      m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_LT_OQ);
+      break;
+    case _CMP_LE_OQ:
+      m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_LE_OQ);
+      break;
+    case _CMP_GT_OQ:
+      m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_GT_OQ);
+      break;
+    case _CMP_GE_OQ:
+      m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_GE_OQ);
+      break;
+    case _CMP_EQ_OQ:
+      m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_EQ_OQ);
+      break;
+    default:
+      m = _mm512_cmp_ps_mask(__m512(a), __m512(b), _CMP_NEQ_UQ);
+      break;
   }
   r = I16(_mm512_movm_epi32(m));
 }
 SOFTRAST_AVX512 void cmp(int predicate, const I16& a, const I16& b, I16& r) {
   __mmask16 m = 0;
   switch (predicate) {
-    case _MM_CMPINT_LT: m = _mm512_cmplt_epi32_mask(__m512i(a), __m512i(b)); break;
-    case _MM_CMPINT_NLE: m = _mm512_cmpgt_epi32_mask(__m512i(a), __m512i(b)); break;
-    case _MM_CMPINT_EQ: m = _mm512_cmpeq_epi32_mask(__m512i(a), __m512i(b)); break;
-    default: m = _mm512_cmpneq_epi32_mask(__m512i(a), __m512i(b)); break;
+    case _MM_CMPINT_LT:
+      m = _mm512_cmplt_epi32_mask(__m512i(a), __m512i(b));
+      break;
+    case _MM_CMPINT_NLE:
+      m = _mm512_cmpgt_epi32_mask(__m512i(a), __m512i(b));
+      break;
+    case _MM_CMPINT_EQ:
+      m = _mm512_cmpeq_epi32_mask(__m512i(a), __m512i(b));
+      break;
+    default:
+      m = _mm512_cmpneq_epi32_mask(__m512i(a), __m512i(b));
+      break;
   }
   r = I16(_mm512_movm_epi32(m));
 }
@@ -334,7 +360,8 @@ inline void sqrt(const Native<4>::F& a, Native<4>::F& r) {
   r = Native<8>::F(_mm256_sqrt_ps(__m256(a)));
 }
 [[gnu::target("avx512f")]] inline void sqrt(const Native<16>::F& a, Native<16>::F& r) {
-  r = Native<16>::F(_mm512_maskz_sqrt_ps(__mmask16(0xffff), __m512(a)));  // maskz: no undefined source
+  r = Native<16>::F(
+      _mm512_maskz_sqrt_ps(__mmask16(0xffff), __m512(a)));  // maskz: no undefined source
 }
 
 inline int sign_bits(const Native<4>::I& a) {
@@ -356,14 +383,14 @@ inline void gather(const int32_t* base, const Native<4>::I& index, Native<4>::I&
   }
 }
 [[gnu::target("avx2")]] inline void gather(const int32_t* base, const Native<8>::I& index,
-                                            Native<8>::I& r) {
+                                           Native<8>::I& r) {
   r = Native<8>::I(_mm256_mask_i32gather_epi32(_mm256_setzero_si256(), base, __m256i(index),
-                                                _mm256_set1_epi32(-1), 4));
+                                               _mm256_set1_epi32(-1), 4));
 }
 [[gnu::target("avx512f")]] inline void gather(const int32_t* base, const Native<16>::I& index,
-                                               Native<16>::I& r) {
-  r = Native<16>::I(
-      _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(0xffff), __m512i(index), base, 4));
+                                              Native<16>::I& r) {
+  r = Native<16>::I(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(0xffff),
+                                                __m512i(index), base, 4));
 }
 
 }  // namespace isa
@@ -401,9 +428,9 @@ alignas(64) inline constexpr uint32_t kLaneToSign[kLanes] = {
     1u << 31, 1u << 30, 1u << 29, 1u << 28, 1u << 27, 1u << 26, 1u << 25, 1u << 24,
     1u << 23, 1u << 22, 1u << 21, 1u << 20, 1u << 19, 1u << 18, 1u << 17, 1u << 16};
 alignas(64) inline constexpr int32_t kLaneColumn[kLanes] = {0, 1, 2, 3, 0, 1, 2, 3,
-                                                             0, 1, 2, 3, 0, 1, 2, 3};
+                                                            0, 1, 2, 3, 0, 1, 2, 3};
 alignas(64) inline constexpr int32_t kLaneRow[kLanes] = {0, 0, 0, 0, 1, 1, 1, 1,
-                                                          2, 2, 2, 2, 3, 3, 3, 3};
+                                                         2, 2, 2, 2, 3, 3, 3, 3};
 
 // The lane mask of a 16-bit block mask. Masks are read by their sign bit everywhere (select,
 // bits, and/or), so lane i only needs bit i of `mask` moved to bit 31: a multiplication by
@@ -451,8 +478,8 @@ SOFTRAST_SIMD_INLINE V load_block(const T* at, size_t stride) {
   } else {
     auto a = __builtin_shufflevector(r[0], r[1], 0, 1, 2, 3, 4, 5, 6, 7);
     auto b = __builtin_shufflevector(r[2], r[3], 0, 1, 2, 3, 4, 5, 6, 7);
-    out.p[0] = Part(
-        __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
+    out.p[0] =
+        Part(__builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
   }
   return out;
 }

@@ -45,8 +45,8 @@ inline float fast_log2(float x) {
   float m;
   std::memcpy(&m, &bits, sizeof m);
   float t = m - 1.0f;
-  float p = t * (1.44182512f + t * (-0.708674935f + t * (0.415397767f + t * (-0.194390433f +
-                                                                              t * 0.0458707517f))));
+  float p = t * (1.44182512f + t * (-0.708674935f +
+                                    t * (0.415397767f + t * (-0.194390433f + t * 0.0458707517f))));
   return exponent + p;
 }
 

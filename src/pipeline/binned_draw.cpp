@@ -273,8 +273,7 @@ class BinnedDraw {
         sink.plane = {in.x_ref, in.y_ref, in.z};
         sink.id = job.next_id++;
         job.interps[sink.id] = &in;
-        rasterize_triangle_scanline(rec.coverage, job.region,
-                                    BlockSink{&ResolveSink::emit, &sink});
+        rasterize_triangle_scanline(rec.coverage, job.region, BlockSink{&ResolveSink::emit, &sink});
       }
     }
     visibility.store_depth();

@@ -53,8 +53,7 @@ template <class V, class T>
 // `e`: the three edge functions at the block's first sample. T is int32_t only where
 // fixed_point.hpp's kSmallTriangleFx8 bound proves every value fits.
 template <class V, class T>
-[[gnu::always_inline]] inline uint32_t coverage_bits(const int64_t e[3],
-                                                     const EdgeOffsets<V>& o) {
+[[gnu::always_inline]] inline uint32_t coverage_bits(const int64_t e[3], const EdgeOffsets<V>& o) {
   uint32_t bits = 0;
   for (int g = 0; g < kGroups; ++g) {
     V all = (T(e[0]) + o.off[0][g]) | (T(e[1]) + o.off[1][g]) | (T(e[2]) + o.off[2][g]);
@@ -212,8 +211,8 @@ struct BlockTarget {
 
   BlockTarget(TileJob& j, const TriRecord& r, int32_t id, const PixelRect& area) : job(j), rec(r) {
     if constexpr (kMode != Mode::kImmediate) {
-      depth_terms(r.interp(), id, area.x0 & ~(kBlockSize - 1), area.x1,
-                  area.y0 & ~(kBlockSize - 1), area.y1, depth);
+      depth_terms(r.interp(), id, area.x0 & ~(kBlockSize - 1), area.x1, area.y0 & ~(kBlockSize - 1),
+                  area.y1, depth);
     }
   }
   [[gnu::always_inline]] void operator()(int x, int y, uint32_t bits) {
@@ -298,7 +297,8 @@ template <Mode kMode, class V, class T>
       Test test = classify(e, mid);
       if (test == Test::kOutside) continue;
       // Only blocks that overlap the area (the 32-bit bound in fixed_point.hpp relies on it).
-      int y_end = std::min(my + kMidBlockSize, area.y1), x_end = std::min(mx + kMidBlockSize, area.x1);
+      int y_end = std::min(my + kMidBlockSize, area.y1),
+          x_end = std::min(mx + kMidBlockSize, area.x1);
       for (int y = std::max(my, by0); y < y_end; y += kBlockSize) {
         for (int x = std::max(mx, bx0); x < x_end; x += kBlockSize) {
           Test sub = test;
@@ -334,8 +334,8 @@ template <Mode kMode>
     // Inside one block (the usual triangle of a dense mesh): that block's coverage, nothing else.
     EdgeOffsets<I> offsets;
     make_offsets<I, int32_t>(t, offsets);
-    uint32_t bits = coverage_bits<I, int32_t>(grid.origin, offsets) &
-                    region_bits(job.region, grid.x0, grid.y0);
+    uint32_t bits =
+        coverage_bits<I, int32_t>(grid.origin, offsets) & region_bits(job.region, grid.x0, grid.y0);
     if (bits != 0) BlockTarget<kMode>(job, rec, id, area)(grid.x0, grid.y0, bits);
     return;
   }
@@ -363,8 +363,7 @@ template <Mode kMode>
 // ---------------------------------------------------------------------------------------------
 // Entry points.
 
-void raster_immediate(TileJob& job, const std::byte* arena, const uint32_t* offsets,
-                      size_t count) {
+void raster_immediate(TileJob& job, const std::byte* arena, const uint32_t* offsets, size_t count) {
   raster_records<Mode::kImmediate>(job, arena, offsets, count);
 }
 void raster_deferred(TileJob& job, const std::byte* arena, const uint32_t* offsets, size_t count) {

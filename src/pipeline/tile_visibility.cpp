@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cstring>
 
-
 namespace softrast::detail {
 
 TileVisibility::TileVisibility() {

@@ -28,7 +28,7 @@ namespace softrast::detail {
 // framebuffer the first time a triangle reaches it and written back after shading, so a tile that
 // few triangles touch costs little. Between tiles every id is kNoWinner.
 struct TileVisibility {
-  static constexpr int kBlocksPerRow = kTileSize / kBlockSize;  // 16
+  static constexpr int kBlocksPerRow = kTileSize / kBlockSize;   // 16
   static constexpr int kBlocks = kBlocksPerRow * kBlocksPerRow;  // 256
   static constexpr int32_t kNoWinner = -1;
 
@@ -74,8 +74,8 @@ struct DepthPlaneRef {
 // Depth-tests the pixels of `mask` in the 4x4 block at pixel (x, y) of the tile against the
 // tile's depth (LESS, or LEQUAL when `less_equal`), and where the test passes writes the
 // fragment's depth and `id`. resolve_block_kernel() picks the widest kernel simd_level() allows.
-using ResolveBlockFn = void (*)(const DepthPlaneRef& plane, int x, int y, uint32_t mask,
-                                int32_t id, bool less_equal, float* depth, int32_t* ids);
+using ResolveBlockFn = void (*)(const DepthPlaneRef& plane, int x, int y, uint32_t mask, int32_t id,
+                                bool less_equal, float* depth, int32_t* ids);
 ResolveBlockFn resolve_block_kernel();
 
 // Whether a draw may take the deferred path (see the file comment for why these conditions).

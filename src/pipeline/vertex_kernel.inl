@@ -13,8 +13,8 @@ typedef int64_t Q __attribute__((vector_size(8 * kD)));
   return reinterpret_cast<D>(_mm512_roundscale_pd(reinterpret_cast<__m512d>(v),
                                                   _MM_FROUND_CUR_DIRECTION | _MM_FROUND_NO_EXC));
 #elif SOFTRAST_DOUBLES == 4
-  return reinterpret_cast<D>(_mm256_round_pd(reinterpret_cast<__m256d>(v),
-                                             _MM_FROUND_CUR_DIRECTION | _MM_FROUND_NO_EXC));
+  return reinterpret_cast<D>(
+      _mm256_round_pd(reinterpret_cast<__m256d>(v), _MM_FROUND_CUR_DIRECTION | _MM_FROUND_NO_EXC));
 #else
   for (int l = 0; l < kD; ++l) v[l] = std::nearbyint(v[l]);  // SSE2 has no rounding instruction
   return v;

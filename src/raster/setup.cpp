@@ -97,9 +97,9 @@ int64_t signed_area_fx16(const WindowVertex& v0, const WindowVertex& v1, const W
          (int64_t(v2.x) - v0.x) * (int64_t(v1.y) - v0.y);
 }
 
-bool setup_triangle_coverage(const WindowVertex& v0, const WindowVertex& v1,
-                             const WindowVertex& v2, int64_t area, const PixelRect& scissor,
-                             TriangleCoverage& out, const WindowVertex* ordered[3]) {
+bool setup_triangle_coverage(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
+                             int64_t area, const PixelRect& scissor, TriangleCoverage& out,
+                             const WindowVertex* ordered[3]) {
   // Clipping keeps every vertex inside the guard band; the bit budget of the edge functions
   // (fixed_point.hpp) depends on it.
   for (const WindowVertex* v : {&v0, &v1, &v2}) {

@@ -81,9 +81,9 @@ bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const Window
 // clockwise into `ordered` and fills the coverage; false when it covers no pixel of `scissor`.
 // The second fills the interpolants. setup_triangle is the area, the cull and these two calls, so
 // every path sets triangles up identically.
-bool setup_triangle_coverage(const WindowVertex& v0, const WindowVertex& v1,
-                             const WindowVertex& v2, int64_t area, const PixelRect& scissor,
-                             TriangleCoverage& out, const WindowVertex* ordered[3]);
+bool setup_triangle_coverage(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
+                             int64_t area, const PixelRect& scissor, TriangleCoverage& out,
+                             const WindowVertex* ordered[3]);
 void setup_triangle_interpolants(const WindowVertex* const ordered[3], int num_varyings,
                                  int64_t area, FrontFace front_face, Interpolants& out);
 

@@ -30,8 +30,7 @@ struct MeshInputs {
 // Samples at the uv in varyings (i, i + 1), with their derivatives when the filter needs them.
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_with_derivatives(const Texture& t, const Sampler& s,
-                                                           const Fragments<N>& f,
-                                      int i) {
+                                                           const Fragments<N>& f, int i) {
   simd::Vec2<N> uv = f.vec2(i);
   if (s.filter != Filter::kTrilinear) return sample<N>(t, s, uv);
   return sample<N>(t, s, uv, {f.ddx(uv.x), f.ddx(uv.y)}, {f.ddy(uv.x), f.ddy(uv.y)});

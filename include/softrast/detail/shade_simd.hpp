@@ -10,12 +10,12 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 
-#include <cstdint>
-#include <type_traits>
-#include <cstring>
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <type_traits>
 
 #include "softrast/detail/interpolants.hpp"
 #include "softrast/framebuffer.hpp"
@@ -30,12 +30,12 @@ namespace softrast {
 template <int N>
 struct Fragments {
   using F = simd::Float<N>;
-  F x, y;                    // window coordinates of the samples (pixel centres)
-  F depth;                   // window depth in [0, 1]; a shader with kWritesDepth may set it
-  simd::Int<N> live;         // lanes still to be written: covered and not discarded
-  bool front_facing = true;  // the primitive's facing
+  F x, y;                       // window coordinates of the samples (pixel centres)
+  F depth;                      // window depth in [0, 1]; a shader with kWritesDepth may set it
+  simd::Int<N> live;            // lanes still to be written: covered and not discarded
+  bool front_facing = true;     // the primitive's facing
   const F* varyings = nullptr;  // the shader's kVaryings values, perspective-correct
-  simd::Vec4<N> color;       // the output, set by the shader
+  simd::Vec4<N> color;          // the output, set by the shader
 
   F varying(int i) const { return varyings[i]; }
   simd::Vec2<N> vec2(int i) const { return {varyings[i], varyings[i + 1]}; }
@@ -66,8 +66,7 @@ struct Fragments {
 namespace detail {
 
 template <class S>
-concept WideShader = requires(const S& s, Fragments<4>& f4, Fragments<8>& f8,
-                              Fragments<16>& f16) {
+concept WideShader = requires(const S& s, Fragments<4>& f4, Fragments<8>& f8, Fragments<16>& f16) {
   s.template shade<4>(f4);
   s.template shade<8>(f8);
   s.template shade<16>(f16);
@@ -250,7 +249,8 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   uint32_t* color_at = &fb.color_row(y)[x];
   if (edge) {
     if (depth_test && depth_write) store_edge_block(depth_at, stride, z, live);
-    I old = blend_mode == BlendMode::kOpaque ? I(0) : load_edge_block<I>(color_at, stride, cols, rows);
+    I old =
+        blend_mode == BlendMode::kOpaque ? I(0) : load_edge_block<I>(color_at, stride, cols, rows);
     store_edge_block(color_at, stride, blend<N>(blend_mode, f.color, old), live);
     return;
   }

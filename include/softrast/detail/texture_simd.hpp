@@ -72,9 +72,8 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> lerp(const simd::Vec4<N>& a, const simd::Vec4
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_level(const Texture& t, const Sampler& s,
                                                 const simd::Vec2<N>& uv, const simd::Int<N>& w,
-                                                const simd::Int<N>& h,
-                                                const simd::Int<N>& offset, bool pow2_u,
-                                                bool pow2_v, bool nearest) {
+                                                const simd::Int<N>& h, const simd::Int<N>& offset,
+                                                bool pow2_u, bool pow2_v, bool nearest) {
   using F = simd::Float<N>;
   using I = simd::Int<N>;
   F fx, fy;
