@@ -233,51 +233,6 @@ TEST(Deferred, SeveralBatchesEqualReference) {
   }
 }
 
-// RenderState::clear (the binned path clears each tile as it starts it) gives the image of
-// Framebuffer::clear followed by the draw: over a framebuffer full of other values, with one and
-// two threads, several batches, deferred and immediate tiles, the reference path, a blended
-// (never deferred) state, and a draw with no triangles.
-TEST(Deferred, ClearAsLoadOperationEqualsClearThenDraw) {
-  Scene big = overdraw_scene(30, 51, true);
-  Scene many = overdraw_scene(36000, 52, false);
-  for (size_t i = 0; i + 2 < many.positions.size(); i += 3) {
-    glm::vec2 c(many.positions[i]);
-    glm::vec4 v[3];
-    for (int k = 0; k < 3; ++k) {
-      glm::vec4 p = many.positions[i + k];
-      v[k] = glm::vec4(c + 0.05f * (glm::vec2(p) - c), p.z, p.w);
-    }
-    big.triangle(v[0], v[1], v[2], many.colors[i]);
-  }
-  Scene empty;
-  RenderState blended = opaque_state(DepthFunc::kLess);
-  blended.blend = BlendMode::kAlpha;
-  const glm::vec4 colour(0.2f, 0.4f, 0.6f, 0.8f);
-  for (const Scene* scene : {&big, &empty}) {
-    for (RenderState state : {opaque_state(DepthFunc::kLess), blended}) {
-      for (int mode = 0; mode < 3; ++mode) {  // threads 1, threads 2, reference path
-        state.threads = mode == 1 ? 2 : 1;
-        state.reference_path = mode == 2;
-        ColorShader shader{scene->positions.data(), scene->colors.data()};
-        Framebuffer expected(301, 187), actual(301, 187);
-        expected.clear(colour, 0.75f, 1);
-        draw_deferrable(expected, state, shader, scene->indices,
-                        uint32_t(scene->positions.size()));
-        actual.clear({1, 0, 1, 1}, 0.0f, 1);  // what the clear must replace everywhere
-        RenderState clearing = state;
-        clearing.clear = true;
-        for (int k = 0; k < 4; ++k) clearing.clear_color[k] = colour[k];
-        clearing.clear_depth = 0.75f;
-        draw_deferrable(actual, clearing, shader, scene->indices,
-                        uint32_t(scene->positions.size()));
-        EXPECT_TRUE(read_back(actual) == read_back(expected))
-            << (scene == &empty ? "no triangles" : "36,030 triangles") << ", mode " << mode
-            << (state.blend == BlendMode::kAlpha ? ", blended" : ", opaque");
-      }
-    }
-  }
-}
-
 // Shades with a counting shader and returns how many pixels were shaded.
 template <class S>
 long count_shaded(const Scene& scene, const RenderState& state, int* visible = nullptr) {

@@ -50,14 +50,6 @@ struct RenderState {
   // immediately in submission order (no binning, no deferred shading, `threads` ignored). The
   // tests hold the fast paths to its image and depth bit for bit.
   bool reference_path = false;
-  // Clear colour and depth before drawing, as a render pass's load operation
-  // (VK_ATTACHMENT_LOAD_OP_CLEAR): the binned path clears each tile as it starts it, while the
-  // tile is in cache, instead of making a separate pass over the whole image. The result is that
-  // of Framebuffer::clear(clear_color, clear_depth) followed by the draw. Colour is RGBA in
-  // [0, 1] (clamped, as Framebuffer::clear_color).
-  bool clear = false;
-  float clear_color[4] = {0.1f, 0.1f, 0.1f, 1.0f};
-  float clear_depth = 1.0f;
 };
 
 }  // namespace softrast

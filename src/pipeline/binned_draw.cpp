@@ -106,17 +106,6 @@ class BinnedDraw {
     for (size_t c = 0; c < num_chunks_; ++c) {
       cache_.chunks[c].bins.resize(size_t(tiles_x_) * size_t(tiles_y_));
     }
-    if (state.clear) {
-      Framebuffer& fb = *target.framebuffer;
-      clear_color_ = pack_rgba8({state.clear_color[0], state.clear_color[1],
-                                 state.clear_color[2], state.clear_color[3]});
-      clear_pending_ = true;
-      if (s.x0 != 0 || s.y0 != 0 || s.x1 != fb.width() || s.y1 != fb.height()) {
-        // Tiles cover the scissor only: clear the whole image first.
-        fb.clear(unpack_rgba8(clear_color_), state.clear_depth, threads);
-        clear_pending_ = false;
-      }
-    }
   }
 
   void draw(const uint32_t* indices, size_t index_count) {
@@ -130,10 +119,6 @@ class BinnedDraw {
         size_t end = std::min(first + count, begin + per_chunk);
         setup_chunk(cache_.chunks[c], indices, begin, end);
       });
-      raster_tiles();
-    }
-    if (clear_pending_) {  // no triangles: the tiles are only cleared (no stale records)
-      for (size_t c = 0; c < num_chunks_; ++c) setup_chunk(cache_.chunks[c], indices, 0, 0);
       raster_tiles();
     }
   }
@@ -232,11 +217,8 @@ class BinnedDraw {
       }
     }
     std::atomic<size_t> next{0};
-    const bool clear = clear_pending_;  // the first batch clears each tile before drawing it
-    clear_pending_ = false;
     parallel_for(workers, threads_, [&](size_t worker) {
       for (size_t tile = next.fetch_add(1); tile < tiles; tile = next.fetch_add(1)) {
-        if (clear) clear_tile(tile);
         if (deferred_ && worth_deferring(tile)) {
           resolve_and_shade_tile(tile, *cache_.scratch[worker]);
         } else {
@@ -244,15 +226,6 @@ class BinnedDraw {
         }
       }
     });
-  }
-
-  void clear_tile(size_t tile) const {
-    PixelRect r = tile_region(tile);
-    Framebuffer& fb = *target_.framebuffer;
-    for (int y = r.y0; y < r.y1; ++y) {
-      std::fill(fb.color_row(y) + r.x0, fb.color_row(y) + r.x1, clear_color_);
-      std::fill(fb.depth_row(y) + r.x0, fb.depth_row(y) + r.x1, state_.clear_depth);
-    }
   }
 
   // Deferred shading pays for its visibility pass only where triangles overlap: a tile whose
@@ -350,8 +323,6 @@ class BinnedDraw {
   size_t record_bytes_ = 0;
   size_t num_chunks_ = 1;
   int tiles_x_ = 0, tiles_y_ = 0;
-  bool clear_pending_ = false;  // RenderState::clear, not yet done
-  uint32_t clear_color_ = 0;
 };
 
 }  // namespace

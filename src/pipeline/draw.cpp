@@ -128,19 +128,12 @@ void SerialDraw::point(const WindowVertex& w) {
 void draw_clip_space(Framebuffer& framebuffer, const RenderState& state,
                      const ClipVertices& vertices, const uint32_t* indices, size_t index_count,
                      const FragmentProgram& program) {
-  int threads = state.threads > 0 ? state.threads : hardware_threads();
-  bool valid = vertices.num_varyings >= 0 && vertices.num_varyings <= kMaxVaryings &&
-               vertices.stride >= 4 + vertices.num_varyings && program.shade_block != nullptr;
-  bool binned = valid && !state.reference_path && state.primitive == Primitive::kTriangles &&
-                !state.wireframe;
-  if (state.clear && !binned) {  // the binned path clears tile by tile (RenderState::clear)
-    const float* c = state.clear_color;
-    framebuffer.clear({c[0], c[1], c[2], c[3]}, state.clear_depth, threads);
-  }
-  if (!valid) return;
+  if (vertices.num_varyings < 0 || vertices.num_varyings > kMaxVaryings) return;
+  if (vertices.stride < 4 + vertices.num_varyings || program.shade_block == nullptr) return;
   GeometryStage geometry(framebuffer.width(), framebuffer.height(), state, vertices);
   ShadeTarget target{&framebuffer, &state};
-  if (binned) {
+  int threads = state.threads > 0 ? state.threads : hardware_threads();
+  if (!state.reference_path && state.primitive == Primitive::kTriangles && !state.wireframe) {
     draw_triangles_binned(geometry, state, target, program, indices, index_count, threads);
     return;
   }

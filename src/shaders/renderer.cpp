@@ -114,15 +114,9 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
     std::span<const uint32_t> indices(mesh.indices.data() + run.first_index, run.index_count);
     Surface surf = surface_of(mesh, run.material, options);
     draw_run(framebuffer, state, mesh, camera, mvp, indices, surf, options, options.shader);
-    state.clear = false;  // the first draw clears (RenderState::clear)
-  }
-  if (state.clear) {  // nothing was drawn
-    const float* c = state.clear_color;
-    framebuffer.clear({c[0], c[1], c[2], c[3]}, state.clear_depth, state.threads);
   }
   if (options.wireframe_overlay && options.shader != ShaderKind::kWireframe) {
     RenderState wire = options.state;
-    wire.clear = false;
     wire.wireframe = true;
     wire.blend = BlendMode::kOpaque;
     wire.depth_write = false;
