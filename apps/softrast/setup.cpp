@@ -21,6 +21,7 @@
 
 #include "softrast/image.hpp"
 #include "softrast/texture.hpp"
+#include "debug_flag.hpp"
 #include "values.hpp"
 
 namespace softrast::cli {
@@ -138,6 +139,7 @@ void interpret_shading(const RawArgs& a, RenderOptions& options, FirstError& e) 
   options.alpha = a.alpha;
   e.take(lookup<Filter>("--filter", kFilters, a.filter), options.sampler.filter);
   e.take(lookup<Wrap>("--wrap", kWraps, a.wrap), options.sampler.wrap_u);
+  e.take(debug_view_named("--debug", a.debug), options.debug_view);
   options.sampler.wrap_v = options.sampler.wrap_u;
 }
 
