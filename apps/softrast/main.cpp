@@ -18,6 +18,7 @@
 #include "args.hpp"
 #include "run.hpp"
 #include "setup.hpp"
+#include "view.hpp"
 #include "softrast/image.hpp"
 
 namespace {
@@ -41,7 +42,8 @@ void report_error(std::string message) {
 // `render` subcommand inserted when it is not given: `softrast` alone is `softrast render`.
 std::vector<std::string> command_arguments(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty() || args.front() != "render") args.insert(args.begin(), "render");
+  bool subcommand = !args.empty() && (args.front() == "render" || args.front() == "view");
+  if (!subcommand) args.insert(args.begin(), "render");
   std::reverse(args.begin(), args.end());
   return args;
 }
@@ -102,6 +104,9 @@ int run(int argc, char** argv) {
   RawArgs raw;
   define_render_flags(*render, raw);
   describe(app, *render);
+  CLI::App* view = app.add_subcommand("view", "Show a model (or the demo scene) in a live window");
+  ViewArgs view_args;
+  define_view_flags(*view, view_args);
   try {
     std::vector<std::string> args = command_arguments(argc, argv);
     app.parse(args);
@@ -110,6 +115,7 @@ int run(int argc, char** argv) {
     report_error(std::string(e.what()) + " (see softrast --help)");
     return kExitUsage;
   }
+  if (view->parsed()) return view_command(view_args, report_error);
   return render_command(raw);
 }
 
