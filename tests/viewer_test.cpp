@@ -17,6 +17,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -32,6 +33,7 @@
 
 #include <gtest/gtest.h>
 
+#include "softrast/debug_view.hpp"
 #include "softrast/image.hpp"
 
 namespace softrast {
@@ -357,6 +359,51 @@ TEST_F(ViewerUnderXvfb, WindowShowsTheFrameSoftrastRenderDrawsAfterMouseAndKeys)
   ASSERT_TRUE(shot.ok()) << shot.status().message();
   EXPECT_EQ(shot->rgba, want.rgba);
 }
+
+#ifdef SOFTRAST_CLI_PATH
+// The command line's side of the debug views and the viewer's errors: one line, no window.
+TEST(ViewerCli, DebugFlagAndErrors) {
+  fs::path dir = fs::temp_directory_path() / ("softrast_viewer_cli_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::string cli = SOFTRAST_CLI_PATH;
+  bool ok = false;
+  fs::path tiles = dir / "tiles.png";
+  std::string out = run(cli + " render -q --debug tiles --size 130x70 -o " + tiles.string() +
+                            " 2>&1", &ok);
+  ASSERT_TRUE(ok) << out;
+  Result<Image> image = load_image(tiles.string());
+  ASSERT_TRUE(image.ok());
+  const uint8_t* grid = image->pixel(64, 10);
+  const uint8_t* beside = image->pixel(65, 10);
+  uint32_t want = kTileGridColor;
+  EXPECT_EQ(grid[0] | grid[1] << 8 | grid[2] << 16 | uint32_t(grid[3]) << 24, want);
+  EXPECT_NE(beside[0] | beside[1] << 8 | beside[2] << 16 | uint32_t(beside[3]) << 24, want);
+
+  struct Case {
+    std::string args;
+    int status;
+    std::string message;
+  };
+  for (const Case& c : {
+           Case{"render --debug heat", 2, "--debug: unknown value 'heat'"},
+           Case{"view --debug heat", 2, "--debug: unknown value 'heat'"},
+           Case{"view --size 0x5", 2, "--size"},
+           Case{"view --frames 0", 2, "--frames: must be in"},
+           Case{"view", 1, "no display to open a window on"},
+       }) {
+    std::string command = "cd " + dir.string() +
+                          " && env -u DISPLAY -u WAYLAND_DISPLAY -u SDL_VIDEODRIVER timeout 20 " +
+                          cli + " " + c.args + " 2>&1 >/dev/null; echo \"status $?\"";
+    std::string err = run(command);
+    EXPECT_NE(err.find("softrast: error: "), std::string::npos) << c.args << ": " << err;
+    EXPECT_NE(err.find(c.message), std::string::npos) << c.args << ": " << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 2) << c.args << ": " << err;
+    EXPECT_NE(err.find("status " + std::to_string(c.status)), std::string::npos) << err;
+  }
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+  fs::remove_all(dir);
+}
+#endif
 
 }  // namespace
 }  // namespace softrast

@@ -54,7 +54,8 @@ void describe(CLI::App& app, CLI::App& render) {
   render.footer(
       "Without MODEL, renders the built-in demo scene with its camera. Without --eye, a model is "
       "framed automatically from +z (from 45 degrees above when it is flat in y). `softrast` "
-      "without a subcommand is `softrast render`.\n\n"
+      "without a subcommand is `softrast render`. `softrast view [MODEL...]` opens the live "
+      "viewer (softrast view --help).\n\n"
       "Examples:\n"
       "  softrast render -o demo.png\n"
       "  softrast render model.obj --size 1920x1080 --shader gouraud --wireframe\n"
