@@ -34,8 +34,8 @@ Camera ortho_camera() {
 // An axis-aligned square facing +z (two counter-clockwise triangles) at depth z.
 void add_quad(Mesh& mesh, float x0, float y0, float x1, float y1, float z) {
   uint32_t base = uint32_t(mesh.positions.size());
-  for (glm::vec3 p : {glm::vec3(x0, y0, z), glm::vec3(x1, y0, z), glm::vec3(x1, y1, z),
-                      glm::vec3(x0, y1, z)}) {
+  for (glm::vec3 p :
+       {glm::vec3(x0, y0, z), glm::vec3(x1, y0, z), glm::vec3(x1, y1, z), glm::vec3(x0, y1, z)}) {
     mesh.positions.push_back(p);
     mesh.normals.push_back({0.0f, 0.0f, 1.0f});
     mesh.uvs.push_back({0.0f, 0.0f});
@@ -63,8 +63,8 @@ class DebugViewTest : public testing::TestWithParam<std::pair<RasterAlgorithm, i
 // them, 0 outside. Their edges lie on pixel borders, so no centre is on an edge.
 TEST_P(DebugViewTest, OverdrawCountsFragmentsPerPixel) {
   Mesh mesh;
-  add_quad(mesh, -0.75f, -0.75f, 0.25f, 0.25f, 0.0f);   // pixels x 8..39, y 24..55
-  add_quad(mesh, -0.25f, -0.25f, 0.75f, 0.75f, 0.5f);   // pixels x 24..55, y 8..39, in front
+  add_quad(mesh, -0.75f, -0.75f, 0.25f, 0.25f, 0.0f);  // pixels x 8..39, y 24..55
+  add_quad(mesh, -0.25f, -0.25f, 0.75f, 0.75f, 0.5f);  // pixels x 24..55, y 8..39, in front
   Framebuffer fb(kSize, kSize);
   fb.clear();
   render_mesh(fb, mesh, ortho_camera(), options(DebugView::kOverdraw));
@@ -72,7 +72,8 @@ TEST_P(DebugViewTest, OverdrawCountsFragmentsPerPixel) {
   int mismatches = 0, overlap = 0;
   for (int y = 0; y < kSize; ++y) {
     for (int x = 0; x < kSize; ++x) {
-      int want = int(inside(x, 8, 40) && inside(y, 24, 56)) + int(inside(x, 24, 56) && inside(y, 8, 40));
+      int want =
+          int(inside(x, 8, 40) && inside(y, 24, 56)) + int(inside(x, 24, 56) && inside(y, 8, 40));
       overlap += want == 2;
       if (fb.color_at(x, y) != overdraw_color(want)) {
         ++mismatches;
@@ -179,12 +180,11 @@ TEST_P(DebugViewTest, CostTimesEachTileAndPaintsTheSlowestRed) {
   EXPECT_EQ(fb.color_at(64, 10), kTileGridColor);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Paths, DebugViewTest,
-    testing::Values(std::pair{RasterAlgorithm::kEdgeEquations, 1},
-                    std::pair{RasterAlgorithm::kEdgeEquations, 2},
-                    std::pair{RasterAlgorithm::kScanline, 2}),
-    view_name);
+INSTANTIATE_TEST_SUITE_P(Paths, DebugViewTest,
+                         testing::Values(std::pair{RasterAlgorithm::kEdgeEquations, 1},
+                                         std::pair{RasterAlgorithm::kEdgeEquations, 2},
+                                         std::pair{RasterAlgorithm::kScanline, 2}),
+                         view_name);
 
 TEST(DebugView, NamesRoundTripAndOverdrawScaleIsDistinct) {
   for (DebugView v : {DebugView::kNone, DebugView::kTiles, DebugView::kOverdraw, DebugView::kCost,

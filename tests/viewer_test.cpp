@@ -149,12 +149,12 @@ std::optional<Image> decode_xwd(const std::string& data, std::string& error) {
   Image image{int(width), int(height)};
   for (uint32_t y = 0; y < height; ++y) {
     for (uint32_t x = 0; x < width; ++x) {
-      const auto* p = reinterpret_cast<const unsigned char*>(data.data()) + offset +
-                      size_t(y) * stride + 4 * x;
-      uint32_t v = byte_order == 0 ? uint32_t(p[0]) | uint32_t(p[1]) << 8 |
-                                         uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24
-                                   : uint32_t(p[3]) | uint32_t(p[2]) << 8 |
-                                         uint32_t(p[1]) << 16 | uint32_t(p[0]) << 24;
+      const auto* p =
+          reinterpret_cast<const unsigned char*>(data.data()) + offset + size_t(y) * stride + 4 * x;
+      uint32_t v =
+          byte_order == 0
+              ? uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24
+              : uint32_t(p[3]) | uint32_t(p[2]) << 8 | uint32_t(p[1]) << 16 | uint32_t(p[0]) << 24;
       uint8_t* out = image.pixel(int(x), int(y));
       for (int c = 0; c < 3; ++c) {
         out[c] = uint8_t((v & masks[c]) >> __builtin_ctz(masks[c]));
@@ -189,10 +189,10 @@ int count_differences(const Image& got, const Image& want, const fs::path& diff_
 
 // A box beside a pyramid on a ground square: asymmetric, so a turned or moved camera shows.
 constexpr const char* kModelObj =
-    "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n"                          // box bottom
-    "v -1 1 -1\nv 1 1 -1\nv 1 1 1\nv -1 1 1\n"                          // box top
+    "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n"                           // box bottom
+    "v -1 1 -1\nv 1 1 -1\nv 1 1 1\nv -1 1 1\n"                           // box top
     "v 1.5 0 -0.5\nv 2.5 0 -0.5\nv 2.5 0 0.5\nv 1.5 0 0.5\nv 2 1.6 0\n"  // pyramid
-    "v -3 -0.01 -3\nv 4 -0.01 -3\nv 4 -0.01 3\nv -3 -0.01 3\n"          // ground
+    "v -3 -0.01 -3\nv 4 -0.01 -3\nv 4 -0.01 3\nv -3 -0.01 3\n"           // ground
     "f 1 2 3 4\nf 8 7 6 5\nf 4 3 7 8\nf 2 1 5 6\nf 3 2 6 7\nf 1 4 8 5\n"
     "f 9 10 13\nf 10 11 13\nf 11 12 13\nf 12 9 13\nf 12 11 10 9\n"
     "f 17 16 15 14\n";
@@ -226,10 +226,10 @@ class ViewerUnderXvfb : public testing::Test {
   void start_xvfb() {
     int fds[2];
     ASSERT_EQ(::pipe(fds), 0);
-    xvfb_.emplace(std::vector<std::string>{*find_program("Xvfb"), "-displayfd",
-                                           std::to_string(fds[1]), "-screen", "0", "640x480x24",
-                                           "-nolisten", "tcp"},
-                  std::vector<std::string>{}, fs::path(), dir_, fds[1]);
+    xvfb_.emplace(
+        std::vector<std::string>{*find_program("Xvfb"), "-displayfd", std::to_string(fds[1]),
+                                 "-screen", "0", "640x480x24", "-nolisten", "tcp"},
+        std::vector<std::string>{}, fs::path(), dir_, fds[1]);
     ::close(fds[1]);
     std::string number;
     pollfd p{fds[0], POLLIN, 0};
@@ -337,8 +337,8 @@ TEST_F(ViewerUnderXvfb, WindowShowsTheFrameSoftrastRenderDrawsAfterMouseAndKeys)
   std::string moved = command_of_frame();
   ASSERT_FALSE(moved.empty());
   EXPECT_NE(moved, initial);
-  for (const char* expected : {"--size 200x150 ", "--shader flat ", "--cull none ",
-                               "--raster scanline", "--wireframe"}) {
+  for (const char* expected :
+       {"--size 200x150 ", "--shader flat ", "--cull none ", "--raster scanline", "--wireframe"}) {
     EXPECT_NE(moved.find(expected), std::string::npos) << expected << " not in: " << moved;
   }
   EXPECT_NE(moved.substr(moved.find("--eye"), 40), initial.substr(initial.find("--eye"), 40));
@@ -368,8 +368,8 @@ TEST(ViewerCli, DebugFlagAndErrors) {
   std::string cli = SOFTRAST_CLI_PATH;
   bool ok = false;
   fs::path tiles = dir / "tiles.png";
-  std::string out = run(cli + " render -q --debug tiles --size 130x70 -o " + tiles.string() +
-                            " 2>&1", &ok);
+  std::string out =
+      run(cli + " render -q --debug tiles --size 130x70 -o " + tiles.string() + " 2>&1", &ok);
   ASSERT_TRUE(ok) << out;
   Result<Image> image = load_image(tiles.string());
   ASSERT_TRUE(image.ok());

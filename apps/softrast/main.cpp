@@ -18,8 +18,8 @@
 #include "args.hpp"
 #include "run.hpp"
 #include "setup.hpp"
-#include "view.hpp"
 #include "softrast/image.hpp"
+#include "view.hpp"
 
 namespace {
 

@@ -11,9 +11,9 @@ namespace softrast::cli {
 namespace {
 
 constexpr float kPi = 3.14159265358979f;
-constexpr float kRadiansPerPixel = 0.01f;      // a 1280-pixel drag turns about two revolutions
+constexpr float kRadiansPerPixel = 0.01f;          // a 1280-pixel drag turns about two revolutions
 constexpr float kMaxPitch = 89.0f * kPi / 180.0f;  // short of the pole, where up = +y breaks
-constexpr float kZoomPerStep = 0.9f;           // one wheel notch: 10% closer
+constexpr float kZoomPerStep = 0.9f;               // one wheel notch: 10% closer
 // Zoom limits as multiples of the bounding radius.
 constexpr float kMinDistance = 1.0e-3f, kMaxDistance = 1.0e3f;
 
@@ -42,9 +42,9 @@ void Orbit::pan(float dx_pixels, float dy_pixels, int height) {
   glm::vec3 forward = glm::normalize(c.target - c.eye);
   glm::vec3 right = glm::normalize(glm::cross(forward, c.up));
   glm::vec3 up = glm::cross(right, forward);
-  float view_height = c.orthographic ? c.ortho_top - c.ortho_bottom
-                                     : 2.0f * state_.distance *
-                                           std::tan(c.fov_y_degrees * kPi / 360.0f);
+  float view_height = c.orthographic
+                          ? c.ortho_top - c.ortho_bottom
+                          : 2.0f * state_.distance * std::tan(c.fov_y_degrees * kPi / 360.0f);
   float world_per_pixel = view_height / float(std::max(height, 1));
   state_.target += (-right * dx_pixels + up * dy_pixels) * world_per_pixel;
 }

@@ -19,9 +19,9 @@
 #include <memory>
 #include <utility>
 
+#include "debug_flag.hpp"
 #include "softrast/image.hpp"
 #include "softrast/texture.hpp"
-#include "debug_flag.hpp"
 #include "values.hpp"
 
 namespace softrast::cli {

@@ -129,8 +129,9 @@ void define_view_flags(CLI::App& app, ViewArgs& a) {
 #ifndef SOFTRAST_HAVE_SDL2
 
 int view_command(const ViewArgs&, void (*report)(std::string message)) {
-  report("this softrast was built without SDL2, so it has no viewer (install libsdl2-dev and "
-         "build again)");
+  report(
+      "this softrast was built without SDL2, so it has no viewer (install libsdl2-dev and "
+      "build again)");
   return kExitRuntime;
 }
 
@@ -139,7 +140,7 @@ int view_command(const ViewArgs&, void (*report)(std::string message)) {
 namespace {
 
 constexpr std::array<ShaderKind, 7> kShaderCycle = {
-    ShaderKind::kPhong,  ShaderKind::kFlat,  ShaderKind::kGouraud,  ShaderKind::kTexture,
+    ShaderKind::kPhong,   ShaderKind::kFlat,  ShaderKind::kGouraud,  ShaderKind::kTexture,
     ShaderKind::kNormals, ShaderKind::kDepth, ShaderKind::kWireframe};
 constexpr std::array<DebugView, 5> kDebugCycle = {DebugView::kNone, DebugView::kTiles,
                                                   DebugView::kOverdraw, DebugView::kCost,
@@ -187,9 +188,9 @@ class Viewer {
   }
 
   Status open() {
-    window_ = SDL_CreateWindow("softrast", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED,
-                               spec_.width, spec_.height,
-                               SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI);
+    window_ =
+        SDL_CreateWindow("softrast", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, spec_.width,
+                         spec_.height, SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI);
     if (!window_) return sdl_error("cannot open a window");
     renderer_ = SDL_CreateRenderer(window_, -1, 0);
     if (!renderer_) return sdl_error("cannot create an SDL renderer");
@@ -233,8 +234,8 @@ class Viewer {
     if (!fb) return fb.status();
     framebuffer_ = std::move(*fb);
     if (texture_) SDL_DestroyTexture(texture_);
-    texture_ = SDL_CreateTexture(renderer_, SDL_PIXELFORMAT_RGBA32, SDL_TEXTUREACCESS_STREAMING,
-                                 w, h);
+    texture_ =
+        SDL_CreateTexture(renderer_, SDL_PIXELFORMAT_RGBA32, SDL_TEXTUREACCESS_STREAMING, w, h);
     if (!texture_) return sdl_error("cannot create a texture");
     SDL_SetTextureBlendMode(texture_, SDL_BLENDMODE_NONE);
     return {};
@@ -278,8 +279,9 @@ class Viewer {
     // Continuous: frames actually shown per second. On demand: what the last frame allows.
     double fps = args_.continuous || args_.frames ? frames_in_interval_ / elapsed
                                                   : 1000.0 / std::max(frame_ms_, 1e-3);
-    int threads = options_.state.threads > 0 ? options_.state.threads
-                                             : int(std::max(1u, std::thread::hardware_concurrency()));
+    int threads = options_.state.threads > 0
+                      ? options_.state.threads
+                      : int(std::max(1u, std::thread::hardware_concurrency()));
     char title[512];
     std::snprintf(title, sizeof title,
                   "softrast  %.1f fps  %.2f ms/frame (render %.2f)  %zu triangles  %d threads  "
@@ -298,9 +300,12 @@ class Viewer {
   }
   const char* cull_name() const {
     switch (options_.state.cull) {
-      case CullMode::kBack: return "back";
-      case CullMode::kFront: return "front";
-      case CullMode::kNone: return "none";
+      case CullMode::kBack:
+        return "back";
+      case CullMode::kFront:
+        return "front";
+      case CullMode::kNone:
+        return "none";
     }
     return "?";
   }
@@ -500,12 +505,12 @@ int view_command(const ViewArgs& args, void (*report)(std::string message)) {
   }
   // Without a display SDL falls back to its offscreen driver, where the viewer would run unseen
   // until killed; SDL_VIDEODRIVER still picks any driver on purpose (kmsdrm on a console).
-  if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY") && !std::getenv("SDL_VIDEODRIVER")) {
+  if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY") &&
+      !std::getenv("SDL_VIDEODRIVER")) {
     report("no display to open a window on (DISPLAY and WAYLAND_DISPLAY are not set)");
     return kExitRuntime;
   }
-  Result<ViewScene> scene =
-      load_view_scene(args.models, float(spec->width) / float(spec->height));
+  Result<ViewScene> scene = load_view_scene(args.models, float(spec->width) / float(spec->height));
   if (!scene) {
     report(scene.status().message());
     return kExitRuntime;
