@@ -66,25 +66,28 @@ class Child {
   // `keep_fd` stays open in the child (Xvfb's -displayfd).
   Child(std::vector<std::string> argv, std::vector<std::string> env, const fs::path& out,
         const fs::path& cwd, int keep_fd = -1) {
+    // Everything the child needs is built here: after fork() in a process with threads, the
+    // child only calls async-signal-safe functions.
+    for (char** e = environ; *e; ++e) env.push_back(*e);  // the additions come first and win
+    std::vector<char*> args, envp;
+    for (std::string& a : argv) args.push_back(a.data());
+    for (std::string& e : env) envp.push_back(e.data());
+    args.push_back(nullptr);
+    envp.push_back(nullptr);
+    std::string out_path = out.empty() ? "/dev/null" : out.string();
+    std::string dir = cwd.string();
     pid_ = ::fork();
     if (pid_ != 0) return;
-    for (const std::string& e : env) ::putenv(const_cast<char*>(e.c_str()));
-    if (!out.empty()) {
-      int fd = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      ::dup2(fd, 1);
-    }
+    int out_fd = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     int null = ::open("/dev/null", O_RDWR);
     ::dup2(null, 0);
-    if (out.empty()) ::dup2(null, 1);
+    ::dup2(out_fd, 1);
     ::dup2(null, 2);
     for (int fd = 3; fd < 1024; ++fd) {
       if (fd != keep_fd) ::close(fd);
     }
-    if (::chdir(cwd.c_str()) != 0) ::_exit(127);
-    std::vector<char*> args;
-    for (std::string& a : argv) args.push_back(a.data());
-    args.push_back(nullptr);
-    ::execv(args[0], args.data());
+    if (::chdir(dir.c_str()) != 0) ::_exit(127);
+    ::execve(args[0], args.data(), envp.data());
     ::_exit(127);
   }
   ~Child() {
@@ -165,7 +168,8 @@ std::optional<Image> decode_xwd(const std::string& data, std::string& error) {
   return image;
 }
 
-// Pixels whose red, green or blue differ; a diff image (red where they do) at `diff_path`.
+// Pixels whose red, green or blue differ; a diff image (red where they do) at `diff_path`
+// unless it is empty.
 int count_differences(const Image& got, const Image& want, const fs::path& diff_path) {
   Image diff(want.width, want.height);
   int bad = 0;
@@ -180,9 +184,10 @@ int count_differences(const Image& got, const Image& want, const fs::path& diff_
       d[3] = 255;
     }
   }
-  if (bad) {
+  if (bad && !diff_path.empty()) {  // with the capture beside it
     EXPECT_TRUE(save_image(diff_path.string(), diff).ok());
-    EXPECT_TRUE(save_image((diff_path.parent_path() / "viewer_capture.png").string(), got).ok());
+    fs::path capture = diff_path;
+    EXPECT_TRUE(save_image(capture.replace_extension(".capture.png").string(), got).ok());
   }
   return bad;
 }
