@@ -33,6 +33,9 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
 #include "softrast/debug_view.hpp"
 #include "softrast/image.hpp"
 
@@ -192,6 +195,30 @@ int count_differences(const Image& got, const Image& want, const fs::path& diff_
   return bad;
 }
 
+// The camera of a printed `softrast render` command.
+struct CameraLine {
+  glm::vec3 eye{0.0f}, target{0.0f};
+  float distance() const { return glm::distance(eye, target); }
+};
+
+glm::vec3 vec3_after(const std::string& line, const std::string& flag) {
+  size_t at = line.find(flag + " ");
+  EXPECT_NE(at, std::string::npos) << flag << " not in: " << line;
+  if (at == std::string::npos) return glm::vec3(0.0f);
+  glm::vec3 v(0.0f);
+  const char* p = line.c_str() + at + flag.size() + 1;
+  for (int i = 0; i < 3; ++i) {
+    char* end = nullptr;
+    v[i] = std::strtof(p, &end);
+    p = end + 1;  // past the comma
+  }
+  return v;
+}
+
+CameraLine camera_of(const std::string& line) {
+  return {vec3_after(line, "--eye"), vec3_after(line, "--target")};
+}
+
 // A box beside a pyramid on a ground square: asymmetric, so a turned or moved camera shows.
 constexpr const char* kModelObj =
     "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n"                           // box bottom
@@ -332,22 +359,41 @@ TEST_F(ViewerUnderXvfb, WindowShowsTheFrameSoftrastRenderDrawsAfterMouseAndKeys)
   std::string initial = command_of_frame();
   ASSERT_FALSE(initial.empty()) << "the viewer printed nothing for Enter";
 
-  // Orbit (left drag), zoom in two notches (wheel up), pan (right drag); then the shader (Tab:
-  // phong -> flat), the wireframe overlay (W), culling off (C) and edge walking (R).
+  // Each mouse action changes what it should and keeps the rest: a left drag orbits (the
+  // target and the distance stay), two wheel notches up come 0.9^2 as close, a right drag pans
+  // (the target moves, the distance stays).
   std::string w = " --window " + window_ + " ";
   x("xdotool mousemove" + w + "100 75 mousedown 1 mousemove" + w + "140 95 mouseup 1");
+  CameraLine start = camera_of(initial), orbited = camera_of(command_of_frame());
+  EXPECT_GT(glm::distance(orbited.eye, start.eye), 0.1f * start.distance());
+  EXPECT_EQ(orbited.target, start.target);
+  EXPECT_NEAR(orbited.distance(), start.distance(), 1e-4f * start.distance());
   x("xdotool mousemove" + w + "100 75 click 4 click 4");
+  CameraLine zoomed = camera_of(command_of_frame());
+  EXPECT_EQ(zoomed.target, start.target);
+  EXPECT_NEAR(zoomed.distance(), 0.81f * start.distance(), 1e-4f * start.distance());
   x("xdotool mousemove" + w + "100 75 mousedown 3 mousemove" + w + "90 70 mouseup 3");
+  CameraLine panned = camera_of(command_of_frame());
+  EXPECT_GT(glm::distance(panned.target, start.target), 0.01f * start.distance());
+  EXPECT_NEAR(panned.distance(), zoomed.distance(), 1e-4f * start.distance());
+
+  // Then the shader (Tab: phong -> flat), the wireframe overlay (W), culling off (C) and edge
+  // walking (R): the window shows what `softrast render` draws with the printed command.
   x("xdotool key --clearmodifiers Tab w c r");
   std::string moved = command_of_frame();
   ASSERT_FALSE(moved.empty());
-  EXPECT_NE(moved, initial);
   for (const char* expected :
        {"--size 200x150 ", "--shader flat ", "--cull none ", "--raster scanline", "--wireframe"}) {
     EXPECT_NE(moved.find(expected), std::string::npos) << expected << " not in: " << moved;
   }
-  EXPECT_NE(moved.substr(moved.find("--eye"), 40), initial.substr(initial.find("--eye"), 40));
   expect_window_shows(render(moved, "moved"), "viewer_moved");
+
+  // D twice: the overdraw debug view, also drawn the same by `softrast render --debug`.
+  x("xdotool key --clearmodifiers d d");
+  std::string overdraw = command_of_frame();
+  EXPECT_NE(overdraw.find("--debug overdraw"), std::string::npos) << overdraw;
+  expect_window_shows(render(overdraw, "overdraw"), "viewer_overdraw");
+  x("xdotool key --clearmodifiers d d d");  // tiles, cost, triangles ... back to none
 
   // A resized window gets a framebuffer of its new size.
   x("xdotool windowsize --sync " + window_ + " 240 160");
@@ -356,8 +402,17 @@ TEST_F(ViewerUnderXvfb, WindowShowsTheFrameSoftrastRenderDrawsAfterMouseAndKeys)
   Image want = render(resized, "resized");
   expect_window_shows(want, "viewer_resized");
 
-  // P saves the frame shown (through save_image), Q quits with status 0.
-  x("xdotool key p q");
+  // P saves the frame shown (through save_image).
+  x("xdotool key --clearmodifiers p");
+
+  // Home puts the camera back where it started.
+  x("xdotool key --clearmodifiers Home");
+  CameraLine reset = camera_of(command_of_frame());
+  EXPECT_EQ(reset.target, start.target);
+  EXPECT_LT(glm::distance(reset.eye, start.eye), 1e-5f * start.distance());
+
+  // Q quits with status 0; the screenshot is the resized frame.
+  x("xdotool key --clearmodifiers q");
   ASSERT_TRUE(viewer_->wait_for(std::chrono::seconds(10))) << "Q did not end the viewer";
   EXPECT_EQ(viewer_->exit_status(), 0);
   Result<Image> shot = load_image((dir_ / "softrast_view_001.png").string());
