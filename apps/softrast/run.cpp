@@ -37,7 +37,7 @@ std::string size_text(const Job& job) {
 // One frame as SCENES.md defines it: clear colour and depth, draw everything. Milliseconds.
 double render_frame(Job& job) {
   auto start = std::chrono::steady_clock::now();
-  job.framebuffer.clear();
+  job.framebuffer.clear({0.1f, 0.1f, 0.1f, 1.0f}, 1.0f, job.options.state.threads);
   render_mesh(job.framebuffer, job.scene.mesh, job.scene.camera, job.options);
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();

@@ -33,6 +33,9 @@ class Framebuffer {
     clear_color();
     clear_depth();
   }
+  // Both at once, in bands of rows spread over `threads` threads (0: every core), each band's
+  // colour and depth together: the frame clear of a renderer that draws on several threads.
+  void clear(glm::vec4 color, float depth, int threads);
 
   // Packed RGBA8 pixel: byte 0 is red (little-endian uint32 = 0xAABBGGRR).
   uint32_t* color_row(int y) { return &color_[size_t(y) * size_t(width_)]; }

@@ -252,19 +252,15 @@ SOFTRAST_SIMD_INLINE Int<N> select(const Int<N>& mask, const Int<N>& a, const In
 
 // min/max with the SSE semantics (and std::min/std::max's): the second operand when either is
 // NaN, so max(NaN, 0) is 0.
+// (One instruction each, defined with the helpers below.)
 template <int N>
-SOFTRAST_SIMD_INLINE Float<N> min(const Float<N>& a, const Float<N>& b) {
-  return select(a < b, a, b);
-}
+SOFTRAST_SIMD_INLINE Float<N> min(const Float<N>& a, const Float<N>& b);
 template <int N>
-SOFTRAST_SIMD_INLINE Float<N> max(const Float<N>& a, const Float<N>& b) {
-  return select(a > b, a, b);
-}
-// std::clamp's definition: v < lo ? lo : (hi < v ? hi : v) (NaN stays NaN).
+SOFTRAST_SIMD_INLINE Float<N> max(const Float<N>& a, const Float<N>& b);
+// std::clamp's definition: v < lo ? lo : (hi < v ? hi : v) (NaN stays NaN), which is
+// max(lo, min(hi, v)) with MINPS/MAXPS's operand order.
 template <int N>
-SOFTRAST_SIMD_INLINE Float<N> clamp(const Float<N>& v, const Float<N>& lo, const Float<N>& hi) {
-  return select(v < lo, lo, select(hi < v, hi, v));
-}
+SOFTRAST_SIMD_INLINE Float<N> clamp(const Float<N>& v, const Float<N>& lo, const Float<N>& hi);
 
 template <int N>
 SOFTRAST_SIMD_INLINE Float<N> to_float(const Int<N>& a) {
@@ -364,6 +360,30 @@ inline void sqrt(const Native<4>::F& a, Native<4>::F& r) {
       _mm512_maskz_sqrt_ps(__mmask16(0xffff), __m512(a)));  // maskz: no undefined source
 }
 
+// r = a < b ? a : b and a > b ? a : b (MINPS / MAXPS: the second operand when either is NaN).
+inline void min(const Native<4>::F& a, const Native<4>::F& b, Native<4>::F& r) {
+  r = Native<4>::F(_mm_min_ps(__m128(a), __m128(b)));
+}
+inline void max(const Native<4>::F& a, const Native<4>::F& b, Native<4>::F& r) {
+  r = Native<4>::F(_mm_max_ps(__m128(a), __m128(b)));
+}
+[[gnu::target("avx")]] inline void min(const Native<8>::F& a, const Native<8>::F& b,
+                                       Native<8>::F& r) {
+  r = Native<8>::F(_mm256_min_ps(__m256(a), __m256(b)));
+}
+[[gnu::target("avx")]] inline void max(const Native<8>::F& a, const Native<8>::F& b,
+                                       Native<8>::F& r) {
+  r = Native<8>::F(_mm256_max_ps(__m256(a), __m256(b)));
+}
+[[gnu::target("avx512f")]] inline void min(const Native<16>::F& a, const Native<16>::F& b,
+                                           Native<16>::F& r) {
+  r = Native<16>::F(_mm512_maskz_min_ps(__mmask16(0xffff), __m512(a), __m512(b)));
+}
+[[gnu::target("avx512f")]] inline void max(const Native<16>::F& a, const Native<16>::F& b,
+                                           Native<16>::F& r) {
+  r = Native<16>::F(_mm512_maskz_max_ps(__mmask16(0xffff), __m512(a), __m512(b)));
+}
+
 inline int sign_bits(const Native<4>::I& a) {
   return _mm_movemask_ps(__m128(a));
 }
@@ -394,6 +414,23 @@ inline void gather(const int32_t* base, const Native<4>::I& index, Native<4>::I&
 }
 
 }  // namespace isa
+
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> min(const Float<N>& a, const Float<N>& b) {
+  Float<N> r;
+  for (int k = 0; k < Float<N>::kParts; ++k) isa::min(a.p[k], b.p[k], r.p[k]);
+  return r;
+}
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> max(const Float<N>& a, const Float<N>& b) {
+  Float<N> r;
+  for (int k = 0; k < Float<N>::kParts; ++k) isa::max(a.p[k], b.p[k], r.p[k]);
+  return r;
+}
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> clamp(const Float<N>& v, const Float<N>& lo, const Float<N>& hi) {
+  return max(lo, min(hi, v));
+}
 
 // IEEE square root, exact in every lane (as std::sqrt).
 template <int N>

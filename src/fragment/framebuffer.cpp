@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include "softrast/detail/parallel.hpp"
+
 namespace softrast {
 
 Framebuffer::Framebuffer(int width, int height)
@@ -29,6 +31,21 @@ void Framebuffer::clear_color(glm::vec4 color) {
 
 void Framebuffer::clear_depth(float depth) {
   std::fill(depth_.begin(), depth_.end(), depth);
+}
+
+void Framebuffer::clear(glm::vec4 color, float depth, int threads) {
+  const uint32_t packed = pack_rgba8(color);
+  // Bands of about 256 KiB of both buffers: enough work per index, and a band's colour and
+  // depth are written by the same thread.
+  const size_t pixels = color_.size();
+  const size_t band = std::max<size_t>(size_t(32) << 10, size_t(width_));
+  const size_t bands = (pixels + band - 1) / band;
+  int n = threads > 0 ? threads : detail::hardware_threads();
+  detail::parallel_for(bands, n, [&](size_t b) {
+    size_t begin = b * band, end = std::min(pixels, begin + band);
+    std::fill(color_.begin() + ptrdiff_t(begin), color_.begin() + ptrdiff_t(end), packed);
+    std::fill(depth_.begin() + ptrdiff_t(begin), depth_.begin() + ptrdiff_t(end), depth);
+  });
 }
 
 Image Framebuffer::to_image() const {

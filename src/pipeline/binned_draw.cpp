@@ -227,13 +227,35 @@ class BinnedDraw {
       for (size_t tile = next.fetch_add(1); tile < tiles; tile = next.fetch_add(1)) {
         auto start = state_.tile_times ? std::chrono::steady_clock::now()
                                        : std::chrono::steady_clock::time_point{};
-        deferred_ ? resolve_and_shade_tile(tile, *cache_.scratch[worker]) : raster_tile(tile);
+        if (deferred_ && worth_deferring(tile)) {
+          resolve_and_shade_tile(tile, *cache_.scratch[worker]);
+        } else {
+          raster_tile(tile);
+        }
         if (state_.tile_times) {  // the `cost` debug view; one thread owns the tile
           std::chrono::duration<double> spent = std::chrono::steady_clock::now() - start;
           state_.tile_times->seconds[tile] += spent.count();
         }
       }
     });
+  }
+
+  // Deferred shading pays for its visibility pass only where triangles overlap: a tile whose
+  // records' bounding boxes, clipped to it, add up to less than kDeferredDepth times its area
+  // (one layer of a mesh: each triangle's box is about twice its area) is shaded immediately,
+  // which gives the same image (the deferred tests compare the two bit for bit).
+  static constexpr int64_t kDeferredDepth = 3;
+  bool worth_deferring(size_t tile) const {
+    PixelRect region = tile_region(tile);
+    int64_t budget = kDeferredDepth * int64_t(region.x1 - region.x0) * (region.y1 - region.y0);
+    for (const Chunk& chunk : chunks()) {
+      for (uint32_t offset : chunk.bins[tile]) {
+        PixelRect r = intersect(record(chunk, offset).coverage.bounds, region);
+        budget -= int64_t(r.x1 - r.x0) * (r.y1 - r.y0);
+        if (budget < 0) return true;
+      }
+    }
+    return false;
   }
 
   // Phase 2, immediate shading: every block of every triangle goes to the fragment stage as it

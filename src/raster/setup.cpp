@@ -88,14 +88,6 @@ void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area
 
 }  // namespace
 
-PixelRect intersect(const PixelRect& a, const PixelRect& b) {
-  return {std::max(a.x0, b.x0), std::max(a.y0, b.y0), std::min(a.x1, b.x1), std::min(a.y1, b.y1)};
-}
-
-int64_t signed_area_fx16(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2) {
-  return (int64_t(v1.x) - v0.x) * (int64_t(v2.y) - v0.y) -
-         (int64_t(v2.x) - v0.x) * (int64_t(v1.y) - v0.y);
-}
 
 bool setup_triangle_coverage(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
                              int64_t area, const PixelRect& scissor, TriangleCoverage& out,

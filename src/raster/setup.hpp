@@ -3,6 +3,7 @@
 // bounding box and the plane equations of the fragment stage. All per-triangle work is here.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 
 #include "raster/fixed_point.hpp"
@@ -35,7 +36,9 @@ struct PixelRect {
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   bool empty() const { return x0 >= x1 || y0 >= y1; }
 };
-PixelRect intersect(const PixelRect& a, const PixelRect& b);
+inline PixelRect intersect(const PixelRect& a, const PixelRect& b) {
+  return {std::max(a.x0, b.x0), std::max(a.y0, b.y0), std::min(a.x1, b.x1), std::min(a.y1, b.y1)};
+}
 
 // Window x or y of the sample point of pixel i, in 1/256 pixel.
 inline int64_t sample_fx8(int i) {
@@ -57,7 +60,11 @@ struct TriangleSetup : TriangleCoverage {
 
 // Twice the signed area of the snapped triangle, (x1-x0)(y2-y0) - (x2-x0)(y1-y0), exact.
 // In y-down window coordinates it is negative for counter-clockwise triangles.
-int64_t signed_area_fx16(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2);
+inline int64_t signed_area_fx16(const WindowVertex& v0, const WindowVertex& v1,
+                                const WindowVertex& v2) {
+  return (int64_t(v1.x) - v0.x) * (int64_t(v2.y) - v0.y) -
+         (int64_t(v2.x) - v0.x) * (int64_t(v1.y) - v0.y);
+}
 
 // Facing and culling from the sign of the snapped area (signed_area_fx16); zero area counts as
 // back-facing.
