@@ -250,7 +250,7 @@ class Viewer {
       glm::mat3 camera_to_world = glm::transpose(glm::mat3(camera.view()));
       options_.light_direction = camera_to_world * glm::normalize(light_);
     }
-    framebuffer_->clear();
+    framebuffer_->clear({0.1f, 0.1f, 0.1f, 1.0f}, 1.0f, options_.state.threads);  // as run.cpp
     render_mesh(*framebuffer_, scene_.mesh, camera, options_);
     return seconds_since(start) * 1000.0;
   }
