@@ -13,6 +13,8 @@ packages=(
   libgtest-dev               # the test suite
   libbenchmark-dev           # the micro-benchmarks (bench/), built but never run by the tests
   libosmesa6-dev libgl-dev   # Mesa llvmpipe, the reference renderer of the difference tests
+  libsdl2-dev                # the live viewer's window, input and texture upload (softrast view)
+  xvfb xdotool x11-apps      # the viewer test: a virtual X server, input events, xwd capture
 )
 sudo=""
 if [ "$(id -u)" != 0 ]; then sudo="sudo"; fi

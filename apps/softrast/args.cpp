@@ -3,6 +3,8 @@
 
 #include "args.hpp"
 
+#include "debug_flag.hpp"
+
 namespace softrast::cli {
 namespace {
 
@@ -55,6 +57,7 @@ void define_shading_flags(CLI::App& app, RawArgs& a) {
       ->type_name("MODE");
   app.add_option("--wrap", a.wrap, "Texture wrap: repeat, clamp or mirror (default repeat)")
       ->type_name("MODE");
+  app.add_option("--debug", a.debug, kDebugViewHelp)->type_name("VIEW");
 }
 
 void define_state_flags(CLI::App& app, RawArgs& a) {

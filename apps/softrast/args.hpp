@@ -32,6 +32,7 @@ struct RawArgs {
   std::string wrap = "repeat";
   std::optional<int> frames;
   bool quiet = false;
+  std::string debug = "none";  // a debug view (softrast/debug_view.hpp)
 };
 
 // Adds every flag of the render command to `app`, storing into `args`.

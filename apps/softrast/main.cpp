@@ -19,6 +19,7 @@
 #include "run.hpp"
 #include "setup.hpp"
 #include "softrast/image.hpp"
+#include "view.hpp"
 
 namespace {
 
@@ -41,7 +42,8 @@ void report_error(std::string message) {
 // `render` subcommand inserted when it is not given: `softrast` alone is `softrast render`.
 std::vector<std::string> command_arguments(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty() || args.front() != "render") args.insert(args.begin(), "render");
+  bool subcommand = !args.empty() && (args.front() == "render" || args.front() == "view");
+  if (!subcommand) args.insert(args.begin(), "render");
   std::reverse(args.begin(), args.end());
   return args;
 }
@@ -52,7 +54,8 @@ void describe(CLI::App& app, CLI::App& render) {
   render.footer(
       "Without MODEL, renders the built-in demo scene with its camera. Without --eye, a model is "
       "framed automatically from +z (from 45 degrees above when it is flat in y). `softrast` "
-      "without a subcommand is `softrast render`.\n\n"
+      "without a subcommand is `softrast render`. `softrast view [MODEL...]` opens the live "
+      "viewer (softrast view --help).\n\n"
       "Examples:\n"
       "  softrast render -o demo.png\n"
       "  softrast render model.obj --size 1920x1080 --shader gouraud --wireframe\n"
@@ -102,6 +105,9 @@ int run(int argc, char** argv) {
   RawArgs raw;
   define_render_flags(*render, raw);
   describe(app, *render);
+  CLI::App* view = app.add_subcommand("view", "Show a model (or the demo scene) in a live window");
+  ViewArgs view_args;
+  define_view_flags(*view, view_args);
   try {
     std::vector<std::string> args = command_arguments(argc, argv);
     app.parse(args);
@@ -110,6 +116,7 @@ int run(int argc, char** argv) {
     report_error(std::string(e.what()) + " (see softrast --help)");
     return kExitUsage;
   }
+  if (view->parsed()) return view_command(view_args, report_error);
   return render_command(raw);
 }
 

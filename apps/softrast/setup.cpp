@@ -19,6 +19,7 @@
 #include <memory>
 #include <utility>
 
+#include "debug_flag.hpp"
 #include "softrast/image.hpp"
 #include "softrast/texture.hpp"
 #include "values.hpp"
@@ -138,6 +139,7 @@ void interpret_shading(const RawArgs& a, RenderOptions& options, FirstError& e) 
   options.alpha = a.alpha;
   e.take(lookup<Filter>("--filter", kFilters, a.filter), options.sampler.filter);
   e.take(lookup<Wrap>("--wrap", kWraps, a.wrap), options.sampler.wrap_u);
+  e.take(debug_view_named("--debug", a.debug), options.debug_view);
   options.sampler.wrap_v = options.sampler.wrap_u;
 }
 

@@ -2,6 +2,8 @@
 // the choice of rasterization algorithm. Plain values; every combination is valid.
 #pragma once
 
+#include <vector>
+
 namespace softrast {
 
 enum class Primitive { kTriangles, kLines, kPoints };
@@ -23,6 +25,19 @@ enum class BlendMode { kOpaque, kAlpha, kAdditive };
 // Two triangle rasterizers with identical coverage: edge equations over tiles (the default) and
 // edge walking over scanlines (a second, independent implementation of the same rules).
 enum class RasterAlgorithm { kEdgeEquations, kScanline };
+
+// Time spent on each 64x64 tile by the binned path (the `cost` debug view). A draw whose state
+// points to one adds each tile's rasterization and shading time, in seconds, to `seconds`
+// (row-major, tiles_x * tiles_y); a draw with a different grid starts it again from zeros.
+// Lines, points and the reference path are not timed.
+struct TileTimes {
+  int tiles_x = 0, tiles_y = 0;
+  std::vector<double> seconds;
+  void clear() {
+    tiles_x = tiles_y = 0;
+    seconds.clear();
+  }
+};
 
 struct RenderState {
   Primitive primitive = Primitive::kTriangles;
@@ -50,6 +65,10 @@ struct RenderState {
   // immediately in submission order (no binning, no deferred shading, `threads` ignored). The
   // tests hold the fast paths to its image and depth bit for bit.
   bool reference_path = false;
+  // Optional per-tile timing (see TileTimes); null: nothing is timed. Each tile is written by
+  // one thread at a time, so the pointee needs no locking, but two draws must not share it
+  // concurrently.
+  TileTimes* tile_times = nullptr;
 };
 
 }  // namespace softrast

@@ -9,6 +9,7 @@
 #include <glm/vec3.hpp>
 
 #include "softrast/camera.hpp"
+#include "softrast/debug_view.hpp"
 #include "softrast/framebuffer.hpp"
 #include "softrast/mesh.hpp"
 #include "softrast/render_state.hpp"
@@ -43,6 +44,9 @@ struct RenderOptions {
   // Draws the culled triangle edges over the shaded mesh as well (hidden edges stay hidden).
   bool wireframe_overlay = false;
   glm::vec3 wire_color{0.05f, 0.05f, 0.05f};
+  // A picture of the pipeline's work instead of (tiles, cost: over) the shaded image. The
+  // overdraw view replaces every pixel's colour; the others draw like a shader.
+  DebugView debug_view = DebugView::kNone;
 };
 
 // Draws `mesh` (positions in world space) seen by `camera` into `framebuffer`, which is not

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "softrast/camera.hpp"        // gluLookAt / gluPerspective / glOrtho camera
+#include "softrast/debug_view.hpp"    // tile grid, overdraw, per-tile cost, triangle colours
 #include "softrast/framebuffer.hpp"   // RGBA8 colour + float depth render target
 #include "softrast/image.hpp"         // images and their files
 #include "softrast/mesh.hpp"          // indexed meshes and the OBJ/MTL loader

@@ -22,6 +22,7 @@
 // order.
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <memory>
 #include <span>
 #include <vector>
@@ -105,6 +106,11 @@ class BinnedDraw {
     if (cache_.chunks.size() < num_chunks_) cache_.chunks.resize(num_chunks_);
     for (size_t c = 0; c < num_chunks_; ++c) {
       cache_.chunks[c].bins.resize(size_t(tiles_x_) * size_t(tiles_y_));
+    }
+    if (TileTimes* t = state.tile_times; t && (t->tiles_x != tiles_x_ || t->tiles_y != tiles_y_)) {
+      t->tiles_x = tiles_x_;
+      t->tiles_y = tiles_y_;
+      t->seconds.assign(size_t(tiles_x_) * size_t(tiles_y_), 0.0);
     }
   }
 
@@ -219,10 +225,16 @@ class BinnedDraw {
     std::atomic<size_t> next{0};
     parallel_for(workers, threads_, [&](size_t worker) {
       for (size_t tile = next.fetch_add(1); tile < tiles; tile = next.fetch_add(1)) {
+        auto start = state_.tile_times ? std::chrono::steady_clock::now()
+                                       : std::chrono::steady_clock::time_point{};
         if (deferred_ && worth_deferring(tile)) {
           resolve_and_shade_tile(tile, *cache_.scratch[worker]);
         } else {
           raster_tile(tile);
+        }
+        if (state_.tile_times) {  // the `cost` debug view; one thread owns the tile
+          std::chrono::duration<double> spent = std::chrono::steady_clock::now() - start;
+          state_.tile_times->seconds[tile] += spent.count();
         }
       }
     });

@@ -5,6 +5,7 @@
 #include <span>
 #include <string_view>
 
+#include "debug/debug_render.hpp"
 #include "shaders/builtin_shaders.hpp"
 #include "softrast/renderer.hpp"
 
@@ -100,6 +101,9 @@ const char* shader_kind_name(ShaderKind kind) {
 
 void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& camera,
                  const RenderOptions& options) {
+  if (options.debug_view != DebugView::kNone) {
+    return detail::render_debug_view(framebuffer, input, camera, options);
+  }
   Mesh storage;
   const Mesh& mesh = complete_mesh(input, storage);
   float aspect = float(framebuffer.width()) / float(framebuffer.height());
