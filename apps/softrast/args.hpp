@@ -32,6 +32,9 @@ struct RawArgs {
   std::string wrap = "repeat";
   std::optional<int> frames;
   bool quiet = false;
+  // Set by define_sequence_flags (sequence.hpp) for `softrast render` only, never in batch jobs.
+  std::optional<int> turntable;
+  bool json = false;
 };
 
 // Adds every flag of the render command to `app`, storing into `args`.

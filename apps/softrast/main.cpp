@@ -16,7 +16,10 @@
 #include <CLI/CLI.hpp>
 
 #include "args.hpp"
+#include "batch.hpp"
+#include "info.hpp"
 #include "run.hpp"
+#include "sequence.hpp"
 #include "setup.hpp"
 #include "softrast/image.hpp"
 
@@ -41,7 +44,10 @@ void report_error(std::string message) {
 // `render` subcommand inserted when it is not given: `softrast` alone is `softrast render`.
 std::vector<std::string> command_arguments(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty() || args.front() != "render") args.insert(args.begin(), "render");
+  const std::vector<std::string> kCommands = {"render", "batch", "info"};
+  if (args.empty() || std::find(kCommands.begin(), kCommands.end(), args.front()) == kCommands.end()) {
+    args.insert(args.begin(), "render");
+  }
   std::reverse(args.begin(), args.end());
   return args;
 }
@@ -79,6 +85,7 @@ void install_signal_handlers() {
 
 // Parses and checks everything, then loads, renders and writes.
 int render_command(const RawArgs& raw) {
+  if (wants_sequence(raw)) return sequence_command(raw);  // --turntable, --json
   Result<JobSpec> spec = interpret(raw);
   if (!spec) {
     report_error(spec.status().message());
@@ -101,7 +108,14 @@ int run(int argc, char** argv) {
   CLI::App* render = app.add_subcommand("render", "Render a model (or the demo scene) to an image");
   RawArgs raw;
   define_render_flags(*render, raw);
+  define_sequence_flags(*render, raw);
   describe(app, *render);
+  CLI::App* batch = app.add_subcommand("batch", "Render every job of a JSON-lines file");
+  BatchArgs batch_args;
+  define_batch_flags(*batch, batch_args);
+  CLI::App* info = app.add_subcommand("info", "Describe models: triangles, bounds, materials");
+  InfoArgs info_args;
+  define_info_flags(*info, info_args);
   try {
     std::vector<std::string> args = command_arguments(argc, argv);
     app.parse(args);
@@ -110,6 +124,8 @@ int run(int argc, char** argv) {
     report_error(std::string(e.what()) + " (see softrast --help)");
     return kExitUsage;
   }
+  if (batch->parsed()) return batch_command(batch_args);
+  if (info->parsed()) return info_command(info_args);
   return render_command(raw);
 }
 

@@ -4,6 +4,7 @@
 // (runtime errors). Nothing is rendered or written before both have succeeded.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -55,7 +56,11 @@ struct Job {
   bool quiet = false;
 };
 
+// Reads one model file; `softrast batch` passes one that keeps the models its jobs share.
+using ModelLoader = std::function<Result<Mesh>(const std::string& path)>;
+
 Result<JobSpec> interpret(const RawArgs& args);
-Result<Job> prepare(const JobSpec& spec);
+// `load_model` (default: load_obj) reads each model file.
+Result<Job> prepare(const JobSpec& spec, const ModelLoader& load_model = {});
 
 }  // namespace softrast::cli
