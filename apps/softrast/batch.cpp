@@ -183,7 +183,7 @@ Status make_parent_folder(const std::string& output) {
 JobResult run_one(const JobLine& line, Batch& batch) {
   auto start = std::chrono::steady_clock::now();
   JobResult result;
-  Result<JobSpec> spec = interpret_job(line.text);
+  Result<JobSpec> spec = interpret_job(line.text, batch.args.defaults);
   if (!spec) return failed(result, spec.status().message());
   result.output = spec->output.value_or("");
   auto first_writer = batch.first_line.find(ModelCache::normal_path(result.output));
@@ -251,6 +251,10 @@ void define_batch_flags(CLI::App& app, BatchArgs& a) {
   app.add_option("--shard", a.shard,
                  "Run only the jobs i with i mod N = K (i counts the non-blank lines from 0)")
       ->type_name("K/N");
+  app.add_option("--defaults", a.defaults,
+                 "A JSON object of job keys for every job that does not give them, e.g. "
+                 "'{\"threads\": 1, \"size\": \"256x256\"}'")
+      ->type_name("JSON");
   app.add_flag("--force", a.force, "Render every job, replacing outputs that exist");
   app.add_flag("--fail-fast", a.fail_fast,
                "Stop at the first failed job (default: keep going, report each failure)");
@@ -289,6 +293,10 @@ int batch_command(const BatchArgs& args) {
       return kExitUsage;
     }
     shard = *parsed;
+  }
+  if (Status s = check_defaults(args.defaults); !s.ok()) {
+    print_error("--defaults: " + s.message());
+    return kExitUsage;
   }
   Result<std::string> content = read_jobs(args.jobs);
   if (!content) {

@@ -13,6 +13,7 @@ namespace softrast::cli {
 struct BatchArgs {
   std::string jobs;  // a path, or "-" for the standard input
   std::optional<std::string> shard;
+  std::string defaults = "{}";  // a JSON object of keys for every job that lacks them
   bool force = false;      // render even when the output exists
   bool fail_fast = false;  // stop at the first failed job
   bool json = false;       // one JSON record per job and a summary on stdout
@@ -23,7 +24,7 @@ struct BatchArgs {
 void define_batch_flags(CLI::App& app, BatchArgs& args);
 
 // Runs the jobs; returns the exit code: 0 when no job failed, 1 when one did (or the jobs file
-// cannot be read), 2 for a bad --shard.
+// cannot be read), 2 for a bad --shard or --defaults.
 int batch_command(const BatchArgs& args);
 
 }  // namespace softrast::cli

@@ -163,7 +163,7 @@ Status add_flag(const CLI::App& app, const std::string& key, const json& value,
   }
   const CLI::Option* option = long_option(app, key);
   if (!option) return unknown_key(key, app);
-  if (option->get_type_size_max() == 0) {  // a flag without a value
+  if (option->get_expected_max() == 0) {  // a flag without a value
     if (!value.is_boolean()) return wrong_kind(key, value, "true or false");
     if (value.get<bool>()) flags.push_back("--" + key);
     return {};
@@ -224,9 +224,12 @@ std::optional<std::string> output_of(const std::string& text) {
   return it->get<std::string>();
 }
 
-Result<JobSpec> interpret_job(const std::string& text) {
+Result<JobSpec> interpret_job(const std::string& text, const std::string& defaults) {
   Result<json> job = parse_object(text);
   if (!job) return job.status();
+  Result<json> shared = parse_object(defaults);
+  if (!shared) return shared.status();
+  for (const auto& [key, value] : shared->items()) job->emplace(key, value);
   RawArgs raw;
   CLI::App app;
   define_render_flags(app, raw);
@@ -239,6 +242,14 @@ Result<JobSpec> interpret_job(const std::string& text) {
     return Status::error(e.what());
   }
   return interpret(raw);
+}
+
+Status check_defaults(const std::string& defaults) {
+  Result<json> shared = parse_object(defaults);
+  if (!shared) return shared.status();
+  if (shared->contains(kOutputKey)) return Status::error("\"output\" differs from job to job");
+  Result<JobSpec> spec = interpret_job("{\"output\": \"check.png\"}", defaults);
+  return spec ? Status() : spec.status();
 }
 
 std::string job_keys() {

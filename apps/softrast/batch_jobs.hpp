@@ -35,7 +35,11 @@ std::optional<std::string> output_of(const std::string& text);
 // not an object, a key given twice, an unknown key (with the closest known one), a key that has no
 // place in a job (frames, quiet, out, ...), a value of the wrong kind, no "output", and every error
 // of the render flags' own checks ("--size: expected WIDTHxHEIGHT such as 800x600, got '64'").
-Result<JobSpec> interpret_job(const std::string& text);
+// `defaults` is a JSON object of keys for the jobs that do not give them ("output" excluded).
+Result<JobSpec> interpret_job(const std::string& text, const std::string& defaults = "{}");
+
+// Checks a --defaults object as a job of its own would be checked (an error without prefix).
+Status check_defaults(const std::string& defaults);
 
 // The keys a job may have, for --help: "model, output, size, eye, ...".
 std::string job_keys();

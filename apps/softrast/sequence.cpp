@@ -219,12 +219,14 @@ bool wants_sequence(const RawArgs& a) {
 
 int sequence_command(const RawArgs& a) {
   auto start = std::chrono::steady_clock::now();
-  Result<std::vector<std::string>> paths = output_paths(a);
-  Status flags = check_script_flags(a);
-  if (flags.ok() && !paths) flags = paths.status();
+  if (Status s = check_script_flags(a); !s.ok()) {
+    print_error(s.message());
+    return kExitUsage;
+  }
+  Result<std::vector<std::string>> paths = output_paths(a);  // at least one
   RawArgs first = a;
   if (paths) first.output = paths->front();
-  Result<JobSpec> spec = flags.ok() ? interpret(first) : Result<JobSpec>(flags);
+  Result<JobSpec> spec = paths ? interpret(first) : Result<JobSpec>(paths.status());
   if (!spec) {
     print_error(spec.status().message());
     return kExitUsage;
