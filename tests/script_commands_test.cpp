@@ -245,17 +245,17 @@ TEST_F(ScriptTest, SecondRunSkipsEveryCompleteOutput) {
 TEST_F(ScriptTest, BadJobsFailAloneWithTheirLineNumbers) {
   write(work() / "jobs.jsonl",
         "{\"model\": \"quad.obj\", \"output\": \"good1.png\", \"size\": \"32x32\"}\n"
-        "{\"model\": \"quad.obj\", \"output\": \"bad.png\", \"size\": \n"                  // 2
-        "{\"model\": \"missing.obj\", \"output\": \"missing.png\"}\n"                      // 3
-        "{\"model\": \"quad.obj\", \"output\": \"shadr.png\", \"shadr\": \"flat\"}\n"      // 4
-        "{\"model\": \"quad.obj\", \"output\": \"zero.png\", \"size\": \"0x5\"}\n"         // 5
-        "{\"model\": \"quad.obj\", \"size\": \"32x32\"}\n"                                 // 6
-        "{\"model\": \"quad.obj\", \"output\": \"good1.png\"}\n"                           // 7
-        "{\"model\": \"quad.obj\", \"output\": \"x.png\", \"output\": \"y.png\"}\n"        // 8
-        "{\"model\": \"quad.obj\", \"output\": \"frames.png\", \"frames\": 3}\n"           // 9
-        "[1, 2]\n"                                                                         // 10
-        "{\"model\": \"quad.obj\", \"output\": \"flag.png\", \"wireframe\": \"yes\"}\n"    // 11
-        "{\"model\": \"quad.obj\", \"output\": \"good2.png\", \"size\": \"32x32\"}\n");    // 12
+        "{\"model\": \"quad.obj\", \"output\": \"bad.png\", \"size\": \n"                // 2
+        "{\"model\": \"missing.obj\", \"output\": \"missing.png\"}\n"                    // 3
+        "{\"model\": \"quad.obj\", \"output\": \"shadr.png\", \"shadr\": \"flat\"}\n"    // 4
+        "{\"model\": \"quad.obj\", \"output\": \"zero.png\", \"size\": \"0x5\"}\n"       // 5
+        "{\"model\": \"quad.obj\", \"size\": \"32x32\"}\n"                               // 6
+        "{\"model\": \"quad.obj\", \"output\": \"good1.png\"}\n"                         // 7
+        "{\"model\": \"quad.obj\", \"output\": \"x.png\", \"output\": \"y.png\"}\n"      // 8
+        "{\"model\": \"quad.obj\", \"output\": \"frames.png\", \"frames\": 3}\n"         // 9
+        "[1, 2]\n"                                                                       // 10
+        "{\"model\": \"quad.obj\", \"output\": \"flag.png\", \"wireframe\": \"yes\"}\n"  // 11
+        "{\"model\": \"quad.obj\", \"output\": \"good2.png\", \"size\": \"32x32\"}\n");  // 12
   Outcome r = run("batch jobs.jsonl");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_EQ(summary(r.err), "batch: 2 rendered, 0 skipped, 10 failed");
@@ -330,8 +330,9 @@ TEST_F(ScriptTest, SigtermMidBatchLeavesNoTemporaryAndARerunCompletes) {
 }
 
 TEST_F(ScriptTest, AJobIsTheRenderCommandWithTheSameFlags) {
-  write(work() / "jobs.jsonl",
-        R"({"model": "quad.obj", "output": "job.png", "size": [40, 30], "shader": "gouraud", "cull": "none", "front-face": "cw", "depth": "lequal", "blend": "alpha", "alpha": 0.5, "raster": "scanline", "filter": "nearest", "wrap": "clamp", "wireframe": true, "threads": 1, "color": [0.2, 0.4, 0.6], "fov": 60, "near": 0.5, "far": 50, "eye": [0.5, -0.25, 5], "target": "0,0,0", "up": [0, 1, 0], "reference-path": true, "light": "1,1,1"}
+  write(
+      work() / "jobs.jsonl",
+      R"({"model": "quad.obj", "output": "job.png", "size": [40, 30], "shader": "gouraud", "cull": "none", "front-face": "cw", "depth": "lequal", "blend": "alpha", "alpha": 0.5, "raster": "scanline", "filter": "nearest", "wrap": "clamp", "wireframe": true, "threads": 1, "color": [0.2, 0.4, 0.6], "fov": 60, "near": 0.5, "far": 50, "eye": [0.5, -0.25, 5], "target": "0,0,0", "up": [0, 1, 0], "reference-path": true, "light": "1,1,1"}
 {"model": "quad.obj", "output": "tex.png", "size": "40x30", "shader": "texture", "texture": "texture.png", "wrap": "mirror", "ortho": [-2, 2, -1.5, 1.5], "near": -1, "far": 10}
 )");
   Outcome batch = run("batch jobs.jsonl");
@@ -342,9 +343,9 @@ TEST_F(ScriptTest, AJobIsTheRenderCommandWithTheSameFlags) {
       "--wireframe --threads 1 --color 0.2,0.4,0.6 --fov 60 --near 0.5 --far 50 "
       "--eye 0.5,-0.25,5 --target 0,0,0 --up 0,1,0 --reference-path --light 1,1,1");
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
-  Outcome tex = run(
-      "render quad.obj -o plain_tex.png --size 40x30 --shader texture --texture texture.png "
-      "--wrap mirror --ortho -2,2,-1.5,1.5 --near -1 --far 10");
+  Outcome tex =
+      run("render quad.obj -o plain_tex.png --size 40x30 --shader texture --texture texture.png "
+          "--wrap mirror --ortho -2,2,-1.5,1.5 --near -1 --far 10");
   ASSERT_EQ(tex.exit_code, 0) << tex.err;
   EXPECT_TRUE(read_file(work() / "job.png") == read_file(work() / "plain.png"));
   EXPECT_TRUE(read_file(work() / "tex.png") == read_file(work() / "plain_tex.png"));
@@ -388,8 +389,10 @@ TEST_F(ScriptTest, ShardMustBeKOverNWithKBelowN) {
   for (const char* shard : {"4/4", "1/0", "a/b", "1", "-1/4", "1/4x", "/4", "0/1000001"}) {
     Outcome r = run(std::string("batch jobs.jsonl --shard '") + shard + "'");
     EXPECT_EQ(r.exit_code, 2) << shard;
-    EXPECT_EQ(r.err, "softrast: error: --shard: expected K/N with 0 <= K < N <= 1000000 (job i "
-                     "runs in shard i mod N), got '" + std::string(shard) + "'\n");
+    EXPECT_EQ(r.err,
+              "softrast: error: --shard: expected K/N with 0 <= K < N <= 1000000 (job i "
+              "runs in shard i mod N), got '" +
+                  std::string(shard) + "'\n");
   }
   Outcome missing = run("batch nothing.jsonl");
   EXPECT_EQ(missing.exit_code, 1);
@@ -414,8 +417,8 @@ TEST_F(ScriptTest, DefaultsFillWhatAJobDoesNotGive) {
   EXPECT_EQ(own->width, 8);
   ASSERT_EQ(run("render quad.obj --size 20x10 --shader flat -o plain.png").exit_code, 0);
   EXPECT_TRUE(read_file(work() / "d.png") == read_file(work() / "plain.png"));
-  for (const char* bad : {"'{\"sise\": 1}'", "'{\"output\": \"x.png\"}'", "'[1]'",
-                          "'{\"size\": \"0x0\"}'"}) {
+  for (const char* bad :
+       {"'{\"sise\": 1}'", "'{\"output\": \"x.png\"}'", "'[1]'", "'{\"size\": \"0x0\"}'"}) {
     Outcome b = run(std::string("batch jobs.jsonl --force --defaults ") + bad);
     EXPECT_EQ(b.exit_code, 2) << bad;
     EXPECT_EQ(b.err.rfind("softrast: error: --defaults: ", 0), 0u) << b.err;
@@ -426,9 +429,9 @@ TEST_F(ScriptTest, DefaultsFillWhatAJobDoesNotGive) {
 TEST_F(ScriptTest, BatchHelpDocumentsTheSchema) {
   Outcome r = run("batch --help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* text : {"--shard", "K/N", "--force", "--fail-fast", "--json", "--defaults", "\"model\"",
-                           "\"output\"", "size", "shader", "eye", "texture", "reference-path",
-                           "skipped", "batch: R rendered, S skipped, F failed"}) {
+  for (const char* text : {"--shard", "K/N", "--force", "--fail-fast", "--json", "--defaults",
+                           "\"model\"", "\"output\"", "size", "shader", "eye", "texture",
+                           "reference-path", "skipped", "batch: R rendered, S skipped, F failed"}) {
     EXPECT_NE(r.out.find(text), std::string::npos) << "batch --help does not mention " << text;
   }
 }
@@ -489,21 +492,24 @@ TEST_F(ScriptTest, InfoReportsGeometryMaterialsAndMaps) {
 
   Outcome text = run("info parts.obj");
   ASSERT_EQ(text.exit_code, 0) << text.err;
-  for (const char* part : {"parts.obj\n", "  triangles  3\n", "bounds     min 0 0 -3  max 5 5 5",
-                           "  mtllib     gone.mtl (MISSING)\n", "      map_Kd texture.png (found)\n",
-                           "      map_Bump bump.png (MISSING)\n", "    red: 2 triangles\n"}) {
+  for (const char* part :
+       {"parts.obj\n", "  triangles  3\n", "bounds     min 0 0 -3  max 5 5 5",
+        "  mtllib     gone.mtl (MISSING)\n", "      map_Kd texture.png (found)\n",
+        "      map_Bump bump.png (MISSING)\n", "    red: 2 triangles\n"}) {
     EXPECT_NE(text.out.find(part), std::string::npos) << "no '" << part << "' in\n" << text.out;
   }
 }
 
 TEST_F(ScriptTest, InfoOnABrokenModelSaysWhyAndStillListsItsFiles) {
   write(work() / "broken.mtl", "newmtl skin\nmap_Kd skin.png\n");
-  write(work() / "broken.obj", "mtllib broken.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl skin\nf 1 2 3\n");
+  write(work() / "broken.obj",
+        "mtllib broken.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl skin\nf 1 2 3\n");
   Outcome r = run("info broken.obj missing.obj quad.obj --json");
   EXPECT_EQ(r.exit_code, 1);
   std::vector<std::string> lines = lines_of(r.out);
   ASSERT_EQ(lines.size(), 3u) << r.out;
-  json broken = json::parse(lines[0]), missing = json::parse(lines[1]), quad = json::parse(lines[2]);
+  json broken = json::parse(lines[0]), missing = json::parse(lines[1]),
+       quad = json::parse(lines[2]);
   EXPECT_NE(broken["error"].get<std::string>().find("skin.png"), std::string::npos);
   EXPECT_EQ(broken["materials"][0]["maps"][0]["found"], false);
   EXPECT_TRUE(missing.contains("error"));

@@ -199,7 +199,8 @@ JobResult run_one(const JobLine& line, Batch& batch) {
   if (Status s = make_parent_folder(result.output); !s.ok()) return failed(result, s.message());
   spec->quiet = true;
   int loaded_before = batch.models.files_loaded();
-  Result<Job> job = prepare(*spec, [&](const std::string& path) { return batch.models.load(path); });
+  Result<Job> job =
+      prepare(*spec, [&](const std::string& path) { return batch.models.load(path); });
   result.models_loaded = batch.models.files_loaded() - loaded_before;
   if (!job) return failed(result, job.status().message());
   if (Status s = run_job(*job); !s.ok()) return failed(result, s.message());
@@ -210,9 +211,12 @@ JobResult run_one(const JobLine& line, Batch& batch) {
 
 const char* outcome_name(Outcome outcome) {
   switch (outcome) {
-    case Outcome::kRendered: return "rendered";
-    case Outcome::kSkipped: return "skipped";
-    case Outcome::kFailed: return "failed";
+    case Outcome::kRendered:
+      return "rendered";
+    case Outcome::kSkipped:
+      return "skipped";
+    case Outcome::kFailed:
+      return "failed";
   }
   return "failed";
 }
@@ -236,8 +240,9 @@ bool report(const JobLine& line, const JobResult& r, const Batch& batch) {
   } else if (!batch.args.quiet) {
     char ms[32];
     std::snprintf(ms, sizeof ms, "%.1f", r.ms);
-    std::string what = r.outcome == Outcome::kRendered ? "rendered " + r.output + " in " + ms + " ms"
-                                                       : "skipped " + r.output + " (exists)";
+    std::string what = r.outcome == Outcome::kRendered
+                           ? "rendered " + r.output + " in " + ms + " ms"
+                           : "skipped " + r.output + " (exists)";
     std::fprintf(stderr, "batch: %s%s\n", where.c_str(), what.c_str());
   }
   return !batch.args.json || print_line(job_record(line, r));
@@ -246,7 +251,8 @@ bool report(const JobLine& line, const JobResult& r, const Batch& batch) {
 }  // namespace
 
 void define_batch_flags(CLI::App& app, BatchArgs& a) {
-  app.add_option("JOBS", a.jobs, "Jobs file: one JSON object per line, one render each ('-': stdin)")
+  app.add_option("JOBS", a.jobs,
+                 "Jobs file: one JSON object per line, one render each ('-': stdin)")
       ->required();
   app.add_option("--shard", a.shard,
                  "Run only the jobs i with i mod N = K (i counts the non-blank lines from 0)")
@@ -273,7 +279,8 @@ void define_batch_flags(CLI::App& app, BatchArgs& a) {
       ". Unknown keys, a key given twice, a missing output and every bad value fail the job with "
       "FILE:LINE: and the reason. Paths are relative to the current folder; an output's folder is "
       "created.\n\n"
-      "A job whose output file exists is skipped (outputs appear complete or not at all: written to "
+      "A job whose output file exists is skipped (outputs appear complete or not at all: written "
+      "to "
       "a temporary file, then renamed), so a killed batch resumes where it stopped when run again. "
       "A failed job does not stop the others. The last line on stderr is 'batch: R rendered, S "
       "skipped, F failed'; the exit status is 1 if any job failed. Jobs sharing a model load it "

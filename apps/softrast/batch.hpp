@@ -14,9 +14,9 @@ struct BatchArgs {
   std::string jobs;  // a path, or "-" for the standard input
   std::optional<std::string> shard;
   std::string defaults = "{}";  // a JSON object of keys for every job that lacks them
-  bool force = false;      // render even when the output exists
-  bool fail_fast = false;  // stop at the first failed job
-  bool json = false;       // one JSON record per job and a summary on stdout
+  bool force = false;           // render even when the output exists
+  bool fail_fast = false;       // stop at the first failed job
+  bool json = false;            // one JSON record per job and a summary on stdout
   bool quiet = false;
 };
 

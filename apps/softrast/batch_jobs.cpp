@@ -135,8 +135,9 @@ Status wrong_kind(const std::string& key, const json& value, const char* expecte
 Result<std::string> value_text(const std::string& key, const json& value) {
   if (value.is_string()) return value.get<std::string>();
   if (value.is_number()) return value.dump();
-  bool numbers = value.is_array() && !value.empty() &&
-                 std::all_of(value.begin(), value.end(), [](const json& v) { return v.is_number(); });
+  bool numbers =
+      value.is_array() && !value.empty() &&
+      std::all_of(value.begin(), value.end(), [](const json& v) { return v.is_number(); });
   if (!numbers) return wrong_kind(key, value, "a string, a number or an array of numbers");
   std::string text, separator = key == "size" ? "x" : ",";
   for (const json& v : value) text += (text.empty() ? "" : separator) + v.dump();
@@ -148,8 +149,9 @@ Status add_models(const json& value, std::vector<std::string>& models) {
     models.push_back(value.get<std::string>());
     return {};
   }
-  bool strings = value.is_array() && !value.empty() &&
-                 std::all_of(value.begin(), value.end(), [](const json& v) { return v.is_string(); });
+  bool strings =
+      value.is_array() && !value.empty() &&
+      std::all_of(value.begin(), value.end(), [](const json& v) { return v.is_string(); });
   if (!strings) return wrong_kind(kModelKey, value, "a path or an array of paths");
   for (const json& v : value) models.push_back(v.get<std::string>());
   return {};
@@ -175,6 +177,19 @@ Status add_flag(const CLI::App& app, const std::string& key, const json& value,
   return {};
 }
 
+// As many models as the render command's MODEL argument takes.
+Status check_model_count(const CLI::App& app, size_t count) {
+  for (const CLI::Option* option : app.get_options()) {
+    if (!option->get_positional() || option->nonpositional()) continue;
+    size_t most = size_t(std::max(option->get_items_expected_max(), 0));
+    if (count > most) {
+      return Status::error("\"model\": at most " + std::to_string(most) + " model" +
+                           (most == 1 ? "" : "s") + " per job, got " + std::to_string(count));
+    }
+  }
+  return {};
+}
+
 // The job as the words of a render command line: flags, then "--", then the models (so that a
 // model path starting with '-' is not read as a flag).
 Result<std::vector<std::string>> job_words(const json& job, const CLI::App& app) {
@@ -194,6 +209,7 @@ Result<std::vector<std::string>> job_words(const json& job, const CLI::App& app)
   if (!job.contains(kOutputKey)) {
     return Status::error("no \"output\": every job names the image it writes");
   }
+  if (Status s = check_model_count(app, models.size()); !s.ok()) return s;
   if (!models.empty()) flags.push_back("--");
   flags.insert(flags.end(), models.begin(), models.end());
   return flags;
@@ -204,7 +220,8 @@ Result<std::vector<std::string>> job_words(const json& job, const CLI::App& app)
 std::vector<JobLine> split_jobs(const std::string& content) {
   std::vector<JobLine> jobs;
   size_t line = 0;
-  for (size_t start = 0; start < content.size();) {
+  size_t first = content.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;  // a UTF-8 byte order mark
+  for (size_t start = first; start < content.size();) {
     size_t end = std::min(content.find('\n', start), content.size());
     std::string text = content.substr(start, end - start);
     ++line;

@@ -25,7 +25,7 @@ struct JobLine {
 };
 
 // The jobs of a file: every line that is not blank (spaces only) is one job. A '\r' before the
-// newline is dropped.
+// newline and a UTF-8 byte order mark at the start are dropped.
 std::vector<JobLine> split_jobs(const std::string& content);
 
 // The "output" of a job line, when the line is a JSON object whose "output" is a string.

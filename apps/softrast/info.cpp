@@ -99,7 +99,8 @@ Scan scan_model(const std::string& path) {
     if (w[0] == "vn") ++scan.normals;
     if (w[0] == "f") ++scan.faces;
     if (w[0] == "mtllib") {
-      for (size_t i = 1; i < w.size(); ++i) scan.libraries.push_back(reference("mtllib", w[i], folder));
+      for (size_t i = 1; i < w.size(); ++i)
+        scan.libraries.push_back(reference("mtllib", w[i], folder));
     }
   }
   for (const Reference& library : scan.libraries) {
@@ -113,7 +114,8 @@ ojson vec3_json(glm::vec3 v) {
 }
 
 ojson reference_json(const Reference& r) {
-  return {{"kind", r.kind}, {"path", r.path}, {"resolved", r.resolved.string()}, {"found", r.found}};
+  return {
+      {"kind", r.kind}, {"path", r.path}, {"resolved", r.resolved.string()}, {"found", r.found}};
 }
 
 const Material* material_named(const Mesh* mesh, const std::string& name) {
@@ -146,9 +148,9 @@ ojson geometry_json(const Mesh& mesh) {
   ojson submeshes = ojson::array();
   for (const SubMesh& s : mesh.submeshes) {
     bool named = s.material >= 0 && size_t(s.material) < mesh.materials.size();
-    submeshes.push_back({{"material", named ? ojson(mesh.materials[size_t(s.material)].name)
-                                            : ojson(nullptr)},
-                         {"triangles", s.index_count / 3}});
+    submeshes.push_back(
+        {{"material", named ? ojson(mesh.materials[size_t(s.material)].name) : ojson(nullptr)},
+         {"triangles", s.index_count / 3}});
   }
   if (mesh.submeshes.empty()) {
     submeshes.push_back({{"material", nullptr}, {"triangles", mesh.triangle_count()}});
@@ -201,17 +203,18 @@ std::string found_text(const ojson& r) {
 void print_geometry(const ojson& info) {
   const ojson& f = info["file"];
   std::printf("  triangles  %s\n", info["triangles"].dump().c_str());
-  std::printf("  vertices   %s (the file: %s positions, %s texture coordinates, %s normals, %s "
-              "faces)\n",
-              info["vertices"].dump().c_str(), f["positions"].dump().c_str(),
-              f["texcoords"].dump().c_str(), f["normals"].dump().c_str(),
-              f["faces"].dump().c_str());
+  std::printf(
+      "  vertices   %s (the file: %s positions, %s texture coordinates, %s normals, %s "
+      "faces)\n",
+      info["vertices"].dump().c_str(), f["positions"].dump().c_str(), f["texcoords"].dump().c_str(),
+      f["normals"].dump().c_str(), f["faces"].dump().c_str());
   const ojson& b = info["bounds"];
   std::printf("  bounds     min %s  max %s  size %s  center %s\n", triple(b["min"]).c_str(),
               triple(b["max"]).c_str(), triple(b["size"]).c_str(), triple(b["center"]).c_str());
   std::printf("  submeshes  %zu\n", info["submeshes"].size());
   for (const ojson& s : info["submeshes"]) {
-    std::string name = s["material"].is_null() ? "(default material)" : s["material"].get<std::string>();
+    std::string name =
+        s["material"].is_null() ? "(default material)" : s["material"].get<std::string>();
     std::printf("    %s: %s triangles\n", name.c_str(), s["triangles"].dump().c_str());
   }
 }
@@ -245,7 +248,8 @@ void define_info_flags(CLI::App& app, InfoArgs& a) {
   app.footer(
       "Vertices are the mesh's (one per distinct position/normal/uv corner), triangles after "
       "fan triangulation. Files a model names are looked up as the loader does (MTL libraries "
-      "beside the OBJ, maps beside their MTL) and marked found or MISSING; only map_Kd is drawn.\n\n"
+      "beside the OBJ, maps beside their MTL) and marked found or MISSING; only map_Kd is "
+      "drawn.\n\n"
       "Examples:\n"
       "  softrast info model.obj\n"
       "  softrast info assets/*.obj --json | jq .triangles");

@@ -63,7 +63,11 @@ void describe(CLI::App& app, CLI::App& render) {
       "  softrast render -o demo.png\n"
       "  softrast render model.obj --size 1920x1080 --shader gouraud --wireframe\n"
       "  softrast render model.obj --eye 0,1,3 --target 0,0,0 --fov 45 --near 0.1 --far 100\n"
-      "  softrast render scene.obj --frames 10    # one JSON line of timings");
+      "  softrast render scene.obj --frames 10    # one JSON line of timings\n"
+      "  softrast render model.obj --turntable 36 -o frames/   # frames/frame_000.png ...\n\n"
+      "Other commands (each with --help):\n"
+      "  softrast info MODEL... [--json]           # triangles, bounds, materials, maps found\n"
+      "  softrast batch JOBS.jsonl [--shard K/N]   # one render per JSON line, resumable");
 }
 
 // SIGINT or SIGTERM: remove the temporary file of an image being written, then die of the signal

@@ -26,8 +26,7 @@ void Progress::update(int done) {
   if (!drawing_) return;
   int filled = int(int64_t(kBarWidth) * std::clamp(done, 0, total_) / total_);
   std::string bar = std::string(size_t(filled), '#') + std::string(size_t(kBarWidth - filled), '.');
-  double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   // "\r" returns to the start of the line; "\033[K" clears what a longer previous draw left.
   std::fprintf(stderr, "\r[%s] %d/%d %s  %.1f s\033[K", bar.c_str(), done, total_, unit_.c_str(),
                seconds);

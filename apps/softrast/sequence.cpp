@@ -45,10 +45,11 @@ struct FramePattern {
 };
 
 Status bad_pattern(const std::string& text) {
-  return Status::error("-o: with --turntable, the output needs one frame number field %d or %0Nd "
-                       "(N = 1..9 digits; %% for a percent sign), as in frame_%03d.png, or a "
-                       "folder ending in /; got '" +
-                       text + "'");
+  return Status::error(
+      "-o: with --turntable, the output needs one frame number field %d or %0Nd "
+      "(N = 1..9 digits; %% for a percent sign), as in frame_%03d.png, or a "
+      "folder ending in /; got '" +
+      text + "'");
 }
 
 // Parses printf-like text with exactly one %d or %0Nd; %% is a literal percent sign.
@@ -111,8 +112,8 @@ Camera orbit_camera(const Job& job, const JobSpec& spec, const Bounds& bounds, i
   flags.up = first.up;
   flags.fov = first.fov_y_degrees;
   if (first.orthographic) {
-    flags.ortho = glm::vec4(first.ortho_left, first.ortho_right, first.ortho_bottom,
-                            first.ortho_top);
+    flags.ortho =
+        glm::vec4(first.ortho_left, first.ortho_right, first.ortho_bottom, first.ortho_top);
   }
   float aspect = float(job.framebuffer.width()) / float(job.framebuffer.height());
   return frame_model(bounds, flags, aspect);
@@ -151,8 +152,9 @@ std::string summary_json(const Job& job, const std::vector<FrameRecord>& records
                          std::optional<int> turntable, double total_ms) {
   json files = json::array();
   for (const FrameRecord& r : records) {
-    files.push_back(
-        {{"path", r.path}, {"render_ms", rounded(r.render_ms, 3)}, {"write_ms", rounded(r.write_ms, 3)}});
+    files.push_back({{"path", r.path},
+                     {"render_ms", rounded(r.render_ms, 3)},
+                     {"write_ms", rounded(r.write_ms, 3)}});
   }
   json summary = {{"scene", job.scene.name},
                   {"source", job.scene.source},
@@ -188,13 +190,13 @@ Result<std::vector<std::string>> output_paths(const RawArgs& a) {
   return paths;
 }
 
-std::string closing_line(const std::vector<FrameRecord>& records, const Job& job,
-                         double total_ms) {
+std::string closing_line(const std::vector<FrameRecord>& records, const Job& job, double total_ms) {
   char seconds[32];
   std::snprintf(seconds, sizeof seconds, "%.2f", total_ms / 1000.0);
   std::string size =
       std::to_string(job.framebuffer.width()) + "x" + std::to_string(job.framebuffer.height());
-  if (records.size() == 1) return "wrote " + records[0].path + " (" + size + ") in " + seconds + " s";
+  if (records.size() == 1)
+    return "wrote " + records[0].path + " (" + size + ") in " + seconds + " s";
   return "wrote " + std::to_string(records.size()) + " frames " + records.front().path + " .. " +
          records.back().path + " (" + size + ") in " + seconds + " s";
 }
