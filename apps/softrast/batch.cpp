@@ -174,8 +174,13 @@ Status make_parent_folder(const std::string& output) {
   fs::path parent = fs::path(output).parent_path();
   std::error_code ec;
   if (parent.empty() || fs::is_directory(parent, ec)) return {};
-  fs::create_directories(parent, ec);
-  if (ec) return Status::error(output + ": cannot create folder '" + parent.string() + "'");
+  std::error_code made;
+  fs::create_directories(parent, made);
+  // Another shard may have made it in the meantime: what matters is that it exists now.
+  if (made && !fs::is_directory(parent, ec)) {
+    return Status::error(output + ": cannot create folder '" + parent.string() +
+                         "': " + made.message());
+  }
   return {};
 }
 
