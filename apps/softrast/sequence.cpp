@@ -19,8 +19,8 @@
 #include "framing.hpp"
 #include "progress.hpp"
 #include "report.hpp"
+#include "run.hpp"
 #include "setup.hpp"
-#include "softrast/image.hpp"
 
 namespace softrast::cli {
 namespace {
@@ -101,9 +101,8 @@ Result<FramePattern> frame_pattern(const std::optional<std::string>& output, int
 // The camera of frame `frame`: the first frame's eye turned about the up axis through the target
 // (right-handed: counter-clockwise seen from above), framed as `softrast render --eye E --target
 // T --up U` would frame it (near and far fitted unless given).
-Camera orbit_camera(const Job& job, const JobSpec& spec, const Bounds& bounds, int frame,
-                    int frames) {
-  const Camera& first = job.scene.camera;
+Camera orbit_camera(const Camera& first, const JobSpec& spec, const Bounds& bounds, float aspect,
+                    int frame, int frames) {
   float angle = float(2.0 * kPi * double(frame) / double(frames));
   glm::mat3 turn(glm::rotate(glm::mat4(1.0f), angle, glm::normalize(first.up)));
   CameraFlags flags = spec.camera;
@@ -115,7 +114,6 @@ Camera orbit_camera(const Job& job, const JobSpec& spec, const Bounds& bounds, i
     flags.ortho =
         glm::vec4(first.ortho_left, first.ortho_right, first.ortho_bottom, first.ortho_top);
   }
-  float aspect = float(job.framebuffer.width()) / float(job.framebuffer.height());
   return frame_model(bounds, flags, aspect);
 }
 
@@ -124,26 +122,27 @@ struct FrameRecord {
   double render_ms = 0.0, write_ms = 0.0;
 };
 
-// Renders frame `frame` (frame 0 with the prepared camera and light) and writes it.
-Result<FrameRecord> render_frame(Job& job, const JobSpec& spec, const Bounds& bounds,
-                                 const std::string& path, int frame, int frames) {
-  RenderOptions options = job.options;
-  Camera camera = job.scene.camera;
+// Renders frame `frame` and writes it, through run_job's own two steps (so a turntable frame is
+// drawn and written as `softrast render` draws and writes). Frame 0 keeps the prepared camera and
+// light; `first` is that camera, turned for the frames after it.
+Result<FrameRecord> render_frame(Job& job, const Camera& first, const JobSpec& spec,
+                                 const Bounds& bounds, const std::string& path, int frame,
+                                 int frames) {
   if (frame > 0) {
-    camera = orbit_camera(job, spec, bounds, frame, frames);
+    float aspect = float(job.framebuffer.width()) / float(job.framebuffer.height());
+    Camera camera = orbit_camera(first, spec, bounds, aspect, frame, frames);
     if (Status s = camera.validate(); !s.ok()) return s;
+    job.scene.camera = camera;
     if (spec.headlight) {  // as prepare() does: the camera's frame to the world
       glm::mat3 camera_to_world = glm::transpose(glm::mat3(camera.view()));
-      options.light_direction = camera_to_world * glm::normalize(spec.options.light_direction);
+      job.options.light_direction = camera_to_world * glm::normalize(spec.options.light_direction);
     }
   }
   FrameRecord record{path};
+  record.render_ms = render_job_frame(job);
   auto start = std::chrono::steady_clock::now();
-  job.framebuffer.clear();
-  render_mesh(job.framebuffer, job.scene.mesh, camera, options);
-  record.render_ms = milliseconds_since(start);
-  start = std::chrono::steady_clock::now();
-  if (Status s = save_image(path, job.framebuffer.to_image()); !s.ok()) return s;
+  job.output = path;
+  if (Status s = write_job_image(job); !s.ok()) return s;
   record.write_ms = milliseconds_since(start);
   return record;
 }
@@ -250,9 +249,12 @@ int sequence_command(const RawArgs& a) {
   Bounds bounds = bounds_of(job->scene.mesh);
   int frames = int(paths->size());
   Progress progress("frames", frames, a.quiet);
+  const Camera first_camera = job->scene.camera;
+  job->quiet = true;  // the progress bar or the closing line instead of a line per image
   std::vector<FrameRecord> records;
   for (int i = 0; i < frames; ++i) {
-    Result<FrameRecord> record = render_frame(*job, *spec, bounds, (*paths)[size_t(i)], i, frames);
+    Result<FrameRecord> record =
+        render_frame(*job, first_camera, *spec, bounds, (*paths)[size_t(i)], i, frames);
     if (!record) {
       if (progress.drawing()) std::fputc('\n', stderr);
       print_error(record.status().message());
