@@ -426,6 +426,73 @@ TEST_F(ScriptTest, DefaultsFillWhatAJobDoesNotGive) {
   }
 }
 
+// The text after `key` in `text` up to the end of its line.
+std::string rest_of_line(const std::string& text, const std::string& key) {
+  size_t at = text.find(key);
+  if (at == std::string::npos) return "";
+  at += key.size();
+  return text.substr(at, text.find('\n', at) - at);
+}
+
+// The jobs each process rendered and skipped, from the summary record its --json output ends with.
+std::pair<int, int> rendered_and_skipped(const fs::path& stdout_log) {
+  std::vector<std::string> lines = lines_of(read_file(stdout_log));
+  if (lines.empty()) return {-1, -1};
+  json summary = json::parse(lines.back())["summary"];
+  return {summary["rendered"].get<int>(), summary["skipped"].get<int>()};
+}
+
+// The Kubernetes manifest and the Slurm script of docs/batch/ run as their schedulers would run
+// them (one process per index, with the variables they set; srun a pass-through): together they
+// render every job once. docs/batch.md shows both files word for word.
+TEST_F(ScriptTest, ClusterFilesInDocsRunEveryJobOnce) {
+  fs::path docs = SOFTRAST_DOCS_DIR;
+  std::string manifest = read_file(docs / "batch/indexed-job.yaml");
+  std::string script = read_file(docs / "batch/job-array.sbatch");
+  std::string guide = read_file(docs / "batch.md");
+  EXPECT_NE(guide.find(manifest), std::string::npos) << "batch.md differs from the manifest";
+  EXPECT_NE(guide.find(script), std::string::npos) << "batch.md differs from the script";
+  write(work() / "jobs.jsonl", twelve_jobs());
+  fs::path bin = fs::path(SOFTRAST_CLI_PATH).parent_path(), shim = root_ / "shim";
+  fs::create_directories(shim);
+  write(shim / "srun", "#!/bin/sh\nexec \"$@\"\n");
+  fs::permissions(shim / "srun", fs::perms::owner_all);
+  std::string path = "PATH=" + quote(shim.string() + ":" + bin.string()) + ":\"$PATH\" ";
+
+  int pods = std::atoi(rest_of_line(manifest, "completions: ").c_str());
+  std::string command = rest_of_line(manifest, "args:\n            - ");
+  ASSERT_EQ(pods, 8);
+  ASSERT_NE(command.find("--shard"), std::string::npos) << command;
+  // Slurm: --array=FIRST-LAST.
+  std::string range = rest_of_line(script, "#SBATCH --array=");
+  int first = std::atoi(range.c_str()), last = std::atoi(range.substr(range.find('-') + 1).c_str());
+  ASSERT_EQ(first, 0);
+  ASSERT_EQ(last, 7);
+
+  for (const char* scheduler : {"kubernetes", "slurm"}) {
+    SCOPED_TRACE(scheduler);
+    fs::remove_all(work() / "out");
+    int rendered = 0, skipped = 0;
+    for (int k = 0; k < 8; ++k) {
+      fs::path out = root_ / "logs" / (scheduler + std::to_string(k));
+      std::string index = std::to_string(k);
+      std::string run_one =
+          std::string(scheduler) == "kubernetes"
+              ? "JOB_COMPLETION_INDEX=" + index + " " + path + "sh -c " + quote(command)
+              : "SLURM_ARRAY_TASK_ID=" + index + " SLURM_SUBMIT_DIR=" + quote(work().string()) +
+                    " " + path + "bash " + quote((docs / "batch/job-array.sbatch").string());
+      std::string line = "cd " + quote(work().string()) + " && " + run_one + " >" +
+                         quote(out.string()) + " 2>/dev/null </dev/null";
+      ASSERT_EQ(std::system(line.c_str()), 0) << line;
+      auto [r, s] = rendered_and_skipped(out);
+      rendered += r, skipped += s;
+    }
+    EXPECT_EQ(rendered, 12);
+    EXPECT_EQ(skipped, 0);
+    EXPECT_EQ(tree(work() / "out").size(), 12u);
+  }
+}
+
 TEST_F(ScriptTest, BatchHelpDocumentsTheSchema) {
   Outcome r = run("batch --help");
   EXPECT_EQ(r.exit_code, 0);
@@ -557,9 +624,9 @@ TEST_F(ScriptTest, TurntableWritesNFramesAroundTheUpAxis) {
 // from +z equals the plain render from -z (within 2/255: the turned eye is off by 4e-7 in x). A
 // light left where frame 0 had it would leave the far face at its ambient level.
 TEST_F(ScriptTest, TurntableFramesAreRendersFromTheTurnedEye) {
-  Outcome r = run(
-      "render cube.obj --shader gouraud --size 48x48 --eye 0,0,5 --target 0,0,0 --turntable 2 "
-      "-o half_%d.png -q");
+  Outcome r =
+      run("render cube.obj --shader gouraud --size 48x48 --eye 0,0,5 --target 0,0,0 --turntable 2 "
+          "-o half_%d.png -q");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_EQ(
       run("render cube.obj --shader gouraud --size 48x48 --eye 0,0,-5 --target 0,0,0 -o back.png")
