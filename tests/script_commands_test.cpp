@@ -493,13 +493,24 @@ TEST_F(ScriptTest, ClusterFilesInDocsRunEveryJobOnce) {
   }
 }
 
-TEST_F(ScriptTest, BatchHelpDocumentsTheSchema) {
+TEST_F(ScriptTest, HelpDocumentsTheScriptCommands) {
   Outcome r = run("batch --help");
   EXPECT_EQ(r.exit_code, 0);
   for (const char* text : {"--shard", "K/N", "--force", "--fail-fast", "--json", "--defaults",
                            "\"model\"", "\"output\"", "size", "shader", "eye", "texture",
                            "reference-path", "skipped", "batch: R rendered, S skipped, F failed"}) {
     EXPECT_NE(r.out.find(text), std::string::npos) << "batch --help does not mention " << text;
+  }
+  Outcome render = run("--help");
+  EXPECT_EQ(render.exit_code, 0);
+  for (const char* text :
+       {"--turntable", "--json", "frame_%03d.png", "FOLDER/", "softrast info", "softrast batch"}) {
+    EXPECT_NE(render.out.find(text), std::string::npos) << "--help does not mention " << text;
+  }
+  Outcome info = run("info --help");
+  EXPECT_EQ(info.exit_code, 0);
+  for (const char* text : {"MODEL", "--json", "bounds", "MISSING"}) {
+    EXPECT_NE(info.out.find(text), std::string::npos) << "info --help does not mention " << text;
   }
 }
 
