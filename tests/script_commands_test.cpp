@@ -351,18 +351,19 @@ TEST_F(ScriptTest, AJobIsTheRenderCommandWithTheSameFlags) {
   EXPECT_TRUE(read_file(work() / "tex.png") == read_file(work() / "plain_tex.png"));
 }
 
-TEST_F(ScriptTest, JsonRecordsAndModelsLoadedOnce) {
+TEST_F(ScriptTest, JsonRecordsAndFilesReadOnce) {
   std::string jobs;
-  for (const char* model : {"quad.obj", "cube.obj", "quad.obj", "cube.obj", "quad.obj"}) {
+  for (const char* model : {"quad.obj", "cube.obj", "./quad.obj", "cube.obj", "quad.obj"}) {
     jobs += "{\"model\": \"" + std::string(model) + "\", \"output\": \"o" +
-            std::to_string(jobs.size()) + ".png\", \"size\": \"16x16\"}\n";
+            std::to_string(jobs.size()) +
+            ".png\", \"size\": \"16x16\", \"texture\": " + "\"texture.png\"}\n";
   }
   write(work() / "jobs.jsonl", jobs);
   Outcome r = run("batch jobs.jsonl --json -q");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::vector<std::string> lines = lines_of(r.out);
   ASSERT_EQ(lines.size(), 6u) << r.out;
-  std::vector<int> loads;
+  std::vector<int> loads, textures;
   for (size_t i = 0; i < 5; ++i) {
     json record = json::parse(lines[i]);
     EXPECT_EQ(record["line"], i + 1);
@@ -371,8 +372,10 @@ TEST_F(ScriptTest, JsonRecordsAndModelsLoadedOnce) {
     EXPECT_TRUE(fs::exists(work() / record["output"].get<std::string>()));
     EXPECT_GE(record["ms"].get<double>(), 0.0);
     loads.push_back(record["models_loaded"].get<int>());
+    textures.push_back(record["textures_loaded"].get<int>());
   }
   EXPECT_EQ(loads, (std::vector<int>{1, 1, 0, 0, 0}));
+  EXPECT_EQ(textures, (std::vector<int>{1, 0, 0, 0, 0}));
   json last = json::parse(lines[5]);
   EXPECT_EQ(last["summary"]["rendered"], 5);
   EXPECT_EQ(last["summary"]["skipped"], 0);

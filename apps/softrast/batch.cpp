@@ -22,6 +22,8 @@
 #include "report.hpp"
 #include "run.hpp"
 #include "setup.hpp"
+#include "softrast/image.hpp"
+#include "softrast/texture.hpp"
 
 namespace softrast::cli {
 namespace {
@@ -31,10 +33,12 @@ using json = nlohmann::ordered_json;
 
 constexpr int64_t kMaxJobsFileBytes = int64_t(256) << 20;
 constexpr int64_t kMaxShards = 1000000;
-// Models kept between jobs, least recently used dropped first: a mesh costs 32 bytes per vertex
-// and 12 per triangle, so 1 GiB holds some 20 million triangles, and a jobs file rendering many
-// views of each model in turn loads every model once.
+// Models and textures kept between jobs, least recently used dropped first: a mesh costs 32 bytes
+// per vertex and 12 per triangle, so 1 GiB holds some 20 million triangles; 512 MiB holds 24
+// textures of 2048x2048 with their mip chains. A jobs file rendering many views of each model in
+// turn reads every file once.
 constexpr size_t kModelCacheBytes = size_t(1) << 30;
+constexpr size_t kTextureCacheBytes = size_t(512) << 20;
 
 struct Shard {
   int64_t index = 0, count = 1;
@@ -83,57 +87,82 @@ Result<std::string> read_jobs(const std::string& path) {
   return content;
 }
 
-// The models of recent jobs, shared with later jobs that name the same file; a job gets its own
-// copy (copying is far cheaper than parsing the OBJ again). Failed loads are not kept.
-class ModelCache {
+// Where a path leads, independent of how a job spells it ("a.obj", "./a.obj").
+std::string normal_path(const std::string& path) {
+  std::error_code ec;
+  fs::path absolute = fs::absolute(path, ec);
+  return (ec ? fs::path(path) : absolute).lexically_normal().string();
+}
+
+// Files read for earlier jobs, kept for later jobs naming the same path; the least recently used
+// are dropped once they hold more than `max_bytes`. A job gets its own copy of a value (for a
+// mesh, copying is far cheaper than parsing the OBJ again; a texture is a shared pointer). Failed
+// reads are not kept, so each job naming a bad file reports it.
+template <class T>
+class FileCache {
  public:
-  Result<Mesh> load(const std::string& path) {
+  using Reader = Result<T> (*)(const std::string& path);
+  using Sizer = size_t (*)(const T& value);
+  FileCache(size_t max_bytes, Reader read, Sizer size)
+      : max_bytes_(max_bytes), read_(read), size_(size) {}
+
+  Result<T> get(const std::string& path) {
     std::string key = normal_path(path);
     for (auto it = entries_.begin(); it != entries_.end(); ++it) {
       if (it->key != key) continue;
       entries_.splice(entries_.begin(), entries_, it);
-      return *it->mesh;
+      return it->value;
     }
-    Result<Mesh> mesh = load_obj(path);
-    ++files_loaded_;
-    if (mesh) keep(key, *mesh);
-    return mesh;
+    Result<T> value = read_(path);
+    ++files_read_;
+    if (value) keep(key, *value);
+    return value;
   }
-  int files_loaded() const { return files_loaded_; }
-
-  static std::string normal_path(const std::string& path) {
-    std::error_code ec;
-    fs::path absolute = fs::absolute(path, ec);
-    return (ec ? fs::path(path) : absolute).lexically_normal().string();
-  }
+  int files_read() const { return files_read_; }
 
  private:
   struct Entry {
     std::string key;
-    std::shared_ptr<const Mesh> mesh;
+    T value;
     size_t bytes;
   };
 
-  static size_t bytes_of(const Mesh& m) {
-    return m.positions.size() * sizeof(glm::vec3) + m.normals.size() * sizeof(glm::vec3) +
-           m.uvs.size() * sizeof(glm::vec2) + m.indices.size() * sizeof(uint32_t);
-  }
-
-  void keep(const std::string& key, const Mesh& mesh) {
-    size_t bytes = bytes_of(mesh);
-    if (bytes > kModelCacheBytes) return;
-    while (!entries_.empty() && bytes_ + bytes > kModelCacheBytes) {
+  void keep(const std::string& key, const T& value) {
+    size_t bytes = size_(value);
+    if (bytes > max_bytes_) return;
+    while (!entries_.empty() && bytes_ + bytes > max_bytes_) {
       bytes_ -= entries_.back().bytes;
       entries_.pop_back();
     }
-    entries_.push_front({key, std::make_shared<const Mesh>(mesh), bytes});
+    entries_.push_front({key, value, bytes});
     bytes_ += bytes;
   }
 
+  size_t max_bytes_;
+  Reader read_;
+  Sizer size_;
   std::list<Entry> entries_;  // most recently used first
   size_t bytes_ = 0;
-  int files_loaded_ = 0;
+  int files_read_ = 0;
 };
+
+size_t mesh_bytes(const Mesh& m) {
+  return m.positions.size() * sizeof(glm::vec3) + m.normals.size() * sizeof(glm::vec3) +
+         m.uvs.size() * sizeof(glm::vec2) + m.indices.size() * sizeof(uint32_t);
+}
+
+using TexturePtr = std::shared_ptr<const Texture>;
+
+Result<TexturePtr> read_texture(const std::string& path) {
+  Result<Image> image = load_image(path);
+  if (!image) return image.status();
+  return TexturePtr(std::make_shared<Texture>(Texture::from_image(*image)));
+}
+
+// The texels and their mip chain (a third more).
+size_t texture_bytes(const TexturePtr& t) {
+  return size_t(t->width()) * size_t(t->height()) * 4 * 4 / 3;
+}
 
 enum class Outcome { kRendered, kSkipped, kFailed };
 
@@ -142,14 +171,16 @@ struct JobResult {
   std::string output;   // as written in the job
   std::string message;  // the error of a failed job
   double ms = 0.0;
-  int models_loaded = 0;  // model files parsed for this job (0: all from the cache)
+  int models_loaded = 0;    // model files parsed for this job (0: all from the cache)
+  int textures_loaded = 0;  // texture files (--texture) decoded for this job
 };
 
 struct Batch {
   const BatchArgs& args;
   std::string name;                          // the jobs file in messages
   std::map<std::string, size_t> first_line;  // output (normal path) -> first line writing it
-  ModelCache models;
+  FileCache<Mesh> models{kModelCacheBytes, load_obj, mesh_bytes};
+  FileCache<TexturePtr> textures{kTextureCacheBytes, read_texture, texture_bytes};
 };
 
 // Every output and the first line that writes it, over the whole file (all shards), so that two
@@ -158,7 +189,7 @@ std::map<std::string, size_t> first_writers(const std::vector<JobLine>& jobs) {
   std::map<std::string, size_t> first;
   for (const JobLine& job : jobs) {
     if (std::optional<std::string> output = output_of(job.text)) {
-      first.emplace(ModelCache::normal_path(*output), job.line);
+      first.emplace(normal_path(*output), job.line);
     }
   }
   return first;
@@ -191,7 +222,7 @@ JobResult run_one(const JobLine& line, Batch& batch) {
   Result<JobSpec> spec = interpret_job(line.text, batch.args.defaults);
   if (!spec) return failed(result, spec.status().message());
   result.output = spec->output.value_or("");
-  auto first_writer = batch.first_line.find(ModelCache::normal_path(result.output));
+  auto first_writer = batch.first_line.find(normal_path(result.output));
   size_t first = first_writer == batch.first_line.end() ? line.line : first_writer->second;
   if (first != line.line) {
     return failed(result, result.output + ": also the output of line " + std::to_string(first));
@@ -203,10 +234,12 @@ JobResult run_one(const JobLine& line, Batch& batch) {
   }
   if (Status s = make_parent_folder(result.output); !s.ok()) return failed(result, s.message());
   spec->quiet = true;
-  int loaded_before = batch.models.files_loaded();
-  Result<Job> job =
-      prepare(*spec, [&](const std::string& path) { return batch.models.load(path); });
-  result.models_loaded = batch.models.files_loaded() - loaded_before;
+  int models_before = batch.models.files_read(), textures_before = batch.textures.files_read();
+  Loaders loaders{[&](const std::string& path) { return batch.models.get(path); },
+                  [&](const std::string& path) { return batch.textures.get(path); }};
+  Result<Job> job = prepare(*spec, loaders);
+  result.models_loaded = batch.models.files_read() - models_before;
+  result.textures_loaded = batch.textures.files_read() - textures_before;
   if (!job) return failed(result, job.status().message());
   if (Status s = run_job(*job); !s.ok()) return failed(result, s.message());
   result.outcome = Outcome::kRendered;
@@ -232,6 +265,7 @@ std::string job_record(const JobLine& line, const JobResult& r) {
   if (r.outcome == Outcome::kRendered) {
     record["ms"] = rounded(r.ms, 3);
     record["models_loaded"] = r.models_loaded;
+    record["textures_loaded"] = r.textures_loaded;
   }
   if (r.outcome == Outcome::kFailed) record["error"] = r.message;
   return record.dump(-1, ' ', false, json::error_handler_t::replace);
@@ -284,12 +318,11 @@ void define_batch_flags(CLI::App& app, BatchArgs& a) {
       ". Unknown keys, a key given twice, a missing output and every bad value fail the job with "
       "FILE:LINE: and the reason. Paths are relative to the current folder; an output's folder is "
       "created.\n\n"
-      "A job whose output file exists is skipped (outputs appear complete or not at all: written "
-      "to "
-      "a temporary file, then renamed), so a killed batch resumes where it stopped when run again. "
-      "A failed job does not stop the others. The last line on stderr is 'batch: R rendered, S "
-      "skipped, F failed'; the exit status is 1 if any job failed. Jobs sharing a model load it "
-      "once.\n\n"
+      "A job whose output file exists is skipped (outputs appear complete or not at all: "
+      "written to a temporary file, then renamed), so a killed batch resumes where it stopped "
+      "when run again. A failed job does not stop the others. The last line on stderr is "
+      "'batch: R rendered, S skipped, F failed'; the exit status is 1 if any job failed. Jobs "
+      "sharing a model or texture read it once.\n\n"
       "Examples:\n"
       "  softrast batch jobs.jsonl\n"
       "  softrast batch jobs.jsonl --shard 2/8      # jobs 2, 10, 18, ... (one of 8 machines)\n"
@@ -316,7 +349,7 @@ int batch_command(const BatchArgs& args) {
     return kExitRuntime;
   }
   std::vector<JobLine> jobs = split_jobs(*content);
-  Batch batch{args, args.jobs == "-" ? "<stdin>" : args.jobs, first_writers(jobs), {}};
+  Batch batch{args, args.jobs == "-" ? "<stdin>" : args.jobs, first_writers(jobs)};
   auto start = std::chrono::steady_clock::now();
   int counts[3] = {0, 0, 0};
   bool output_ok = true;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -16,6 +17,7 @@
 #include "softrast/mesh.hpp"
 #include "softrast/renderer.hpp"
 #include "softrast/status.hpp"
+#include "softrast/texture.hpp"
 
 namespace softrast::cli {
 
@@ -56,11 +58,14 @@ struct Job {
   bool quiet = false;
 };
 
-// Reads one model file; `softrast batch` passes one that keeps the models its jobs share.
-using ModelLoader = std::function<Result<Mesh>(const std::string& path)>;
+// How prepare() reads files; `softrast batch` passes loaders that keep what its jobs share. An
+// empty function means the usual reader (load_obj, load_image).
+struct Loaders {
+  std::function<Result<Mesh>(const std::string& path)> model;
+  std::function<Result<std::shared_ptr<const Texture>>(const std::string& path)> texture;
+};
 
 Result<JobSpec> interpret(const RawArgs& args);
-// `load_model` (default: load_obj) reads each model file.
-Result<Job> prepare(const JobSpec& spec, const ModelLoader& load_model = {});
+Result<Job> prepare(const JobSpec& spec, const Loaders& loaders = {});
 
 }  // namespace softrast::cli
