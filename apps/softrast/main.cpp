@@ -3,6 +3,8 @@
 // and SIGTERM still end it as signals, after removing any temporary image file.
 //
 //   softrast [render] [MODEL] [-o out.png] [flags]     see `softrast --help`
+//   softrast batch JOBS.jsonl [--shard K/N]             see `softrast batch --help`
+//   softrast info MODEL... [--json]
 
 #include <signal.h>
 
@@ -41,11 +43,13 @@ void report_error(std::string message) {
 }
 
 // The arguments after the program name, for CLI11 (which wants them reversed), with the
-// `render` subcommand inserted when it is not given: `softrast` alone is `softrast render`.
+// `render` subcommand inserted when the first argument names no command (render, batch, info):
+// `softrast` alone is `softrast render`.
 std::vector<std::string> command_arguments(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   const std::vector<std::string> kCommands = {"render", "batch", "info"};
-  if (args.empty() || std::find(kCommands.begin(), kCommands.end(), args.front()) == kCommands.end()) {
+  if (args.empty() ||
+      std::find(kCommands.begin(), kCommands.end(), args.front()) == kCommands.end()) {
     args.insert(args.begin(), "render");
   }
   std::reverse(args.begin(), args.end());
