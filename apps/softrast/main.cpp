@@ -1,6 +1,7 @@
-// apps/softrast/main.cpp: the softrast command line. The only place that prints errors and
-// chooses exit codes: 0 success, 1 runtime error (files, memory), 2 usage error (flags); SIGINT
-// and SIGTERM still end it as signals, after removing any temporary image file.
+// apps/softrast/main.cpp: the softrast command line. Exit codes: 0 success, 1 runtime error
+// (files, memory, failed batch jobs), 2 usage error (flags); every error is one line
+// "softrast: error: ..." (here, and in batch, info and sequence through report.hpp). SIGINT and
+// SIGTERM still end it as signals, after removing any temporary image file.
 //
 //   softrast [render] [MODEL] [-o out.png] [flags]     see `softrast --help`
 //   softrast batch JOBS.jsonl [--shard K/N]             see `softrast batch --help`
