@@ -10,6 +10,7 @@ packages=(
   libjpeg62-turbo-dev        # JPEG decoding: fuzzed upstream, size known before allocation
   zlib1g-dev                 # crc32 for the PNG chunks the decoder tests build byte by byte
   libcli11-dev               # the command line
+  nlohmann-json3-dev         # JSON: batch job lines, --json records (header-only)
   libgtest-dev               # the test suite
   libbenchmark-dev           # the micro-benchmarks (bench/), built but never run by the tests
   libosmesa6-dev libgl-dev   # Mesa llvmpipe, the reference renderer of the difference tests

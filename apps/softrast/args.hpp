@@ -33,6 +33,9 @@ struct RawArgs {
   std::optional<int> frames;
   bool quiet = false;
   std::string debug = "none";  // a debug view (softrast/debug_view.hpp)
+  // Set by define_sequence_flags (sequence.hpp) for `softrast render` only, never in batch jobs.
+  std::optional<int> turntable;
+  bool json = false;
 };
 
 // Adds every flag of the render command to `app`, storing into `args`.

@@ -1,8 +1,11 @@
-// apps/softrast/main.cpp: the softrast command line. The only place that prints errors and
-// chooses exit codes: 0 success, 1 runtime error (files, memory), 2 usage error (flags); SIGINT
-// and SIGTERM still end it as signals, after removing any temporary image file.
+// apps/softrast/main.cpp: the softrast command line. Exit codes: 0 success, 1 runtime error
+// (files, memory, failed batch jobs), 2 usage error (flags); every error is one line
+// "softrast: error: ..." (here, and in batch, info and sequence through report.hpp). SIGINT and
+// SIGTERM still end it as signals, after removing any temporary image file.
 //
 //   softrast [render] [MODEL] [-o out.png] [flags]     see `softrast --help`
+//   softrast batch JOBS.jsonl [--shard K/N]             see `softrast batch --help`
+//   softrast info MODEL... [--json]
 
 #include <signal.h>
 
@@ -16,7 +19,10 @@
 #include <CLI/CLI.hpp>
 
 #include "args.hpp"
+#include "batch.hpp"
+#include "info.hpp"
 #include "run.hpp"
+#include "sequence.hpp"
 #include "setup.hpp"
 #include "softrast/image.hpp"
 #include "view.hpp"
@@ -39,11 +45,15 @@ void report_error(std::string message) {
 }
 
 // The arguments after the program name, for CLI11 (which wants them reversed), with the
-// `render` subcommand inserted when it is not given: `softrast` alone is `softrast render`.
+// `render` subcommand inserted when the first argument names no command (render, batch, info):
+// `softrast` alone is `softrast render`.
 std::vector<std::string> command_arguments(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  bool subcommand = !args.empty() && (args.front() == "render" || args.front() == "view");
-  if (!subcommand) args.insert(args.begin(), "render");
+  const std::vector<std::string> kCommands = {"render", "batch", "info", "view"};
+  if (args.empty() ||
+      std::find(kCommands.begin(), kCommands.end(), args.front()) == kCommands.end()) {
+    args.insert(args.begin(), "render");
+  }
   std::reverse(args.begin(), args.end());
   return args;
 }
@@ -60,7 +70,11 @@ void describe(CLI::App& app, CLI::App& render) {
       "  softrast render -o demo.png\n"
       "  softrast render model.obj --size 1920x1080 --shader gouraud --wireframe\n"
       "  softrast render model.obj --eye 0,1,3 --target 0,0,0 --fov 45 --near 0.1 --far 100\n"
-      "  softrast render scene.obj --frames 10    # one JSON line of timings");
+      "  softrast render scene.obj --frames 10    # one JSON line of timings\n"
+      "  softrast render model.obj --turntable 36 -o frames/   # frames/frame_000.png ...\n\n"
+      "Other commands (each with --help):\n"
+      "  softrast info MODEL... [--json]           # triangles, bounds, materials, maps found\n"
+      "  softrast batch JOBS.jsonl [--shard K/N]   # one render per JSON line, resumable");
 }
 
 // SIGINT or SIGTERM: remove the temporary file of an image being written, then die of the signal
@@ -82,6 +96,7 @@ void install_signal_handlers() {
 
 // Parses and checks everything, then loads, renders and writes.
 int render_command(const RawArgs& raw) {
+  if (wants_sequence(raw)) return sequence_command(raw);  // --turntable, --json
   Result<JobSpec> spec = interpret(raw);
   if (!spec) {
     report_error(spec.status().message());
@@ -104,10 +119,17 @@ int run(int argc, char** argv) {
   CLI::App* render = app.add_subcommand("render", "Render a model (or the demo scene) to an image");
   RawArgs raw;
   define_render_flags(*render, raw);
+  define_sequence_flags(*render, raw);
   describe(app, *render);
   CLI::App* view = app.add_subcommand("view", "Show a model (or the demo scene) in a live window");
   ViewArgs view_args;
   define_view_flags(*view, view_args);
+  CLI::App* batch = app.add_subcommand("batch", "Render every job of a JSON-lines file");
+  BatchArgs batch_args;
+  define_batch_flags(*batch, batch_args);
+  CLI::App* info = app.add_subcommand("info", "Describe models: triangles, bounds, materials");
+  InfoArgs info_args;
+  define_info_flags(*info, info_args);
   try {
     std::vector<std::string> args = command_arguments(argc, argv);
     app.parse(args);
@@ -117,6 +139,8 @@ int run(int argc, char** argv) {
     return kExitUsage;
   }
   if (view->parsed()) return view_command(view_args, report_error);
+  if (batch->parsed()) return batch_command(batch_args);
+  if (info->parsed()) return info_command(info_args);
   return render_command(raw);
 }
 

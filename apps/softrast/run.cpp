@@ -135,4 +135,12 @@ Status run_job(Job& job) {
   return write_image(job);
 }
 
+double render_job_frame(Job& job) {
+  return render_frame(job);
+}
+
+Status write_job_image(const Job& job) {
+  return write_image(job);
+}
+
 }  // namespace softrast::cli

@@ -223,7 +223,7 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
 
 // A model file framed automatically, or the demo scene with its own camera; the flags override
 // either.
-Result<Scene> load_scene(const JobSpec& spec) {
+Result<Scene> load_scene(const JobSpec& spec, const Loaders& loaders) {
   auto start = std::chrono::steady_clock::now();
   Scene scene;
   if (!spec.model) {
@@ -232,7 +232,7 @@ Result<Scene> load_scene(const JobSpec& spec) {
     scene.camera = demo.camera;
     apply_flags(scene.camera, spec.camera);
   } else {
-    Result<Mesh> mesh = load_obj(*spec.model);
+    Result<Mesh> mesh = loaders.model ? loaders.model(*spec.model) : load_obj(*spec.model);
     if (!mesh) return mesh.status();
     scene.mesh = std::move(*mesh);
     float aspect = float(spec.width) / float(spec.height);
@@ -262,17 +262,18 @@ Result<JobSpec> interpret(const RawArgs& args) {
   return spec;
 }
 
-Result<Job> prepare(const JobSpec& spec) {
+Result<Job> prepare(const JobSpec& spec, const Loaders& loaders) {
   if (spec.output) {
     if (Status s = check_output_path(*spec.output); !s.ok()) return s;
   }
   RenderOptions options = spec.options;
   if (spec.texture) {
-    Result<std::shared_ptr<const Texture>> texture = load_texture(*spec.texture);
+    Result<std::shared_ptr<const Texture>> texture =
+        loaders.texture ? loaders.texture(*spec.texture) : load_texture(*spec.texture);
     if (!texture) return texture.status();
     options.texture = std::move(*texture);
   }
-  Result<Scene> scene = load_scene(spec);
+  Result<Scene> scene = load_scene(spec, loaders);
   if (!scene) return scene.status();
   // Allocated last: up to 2 GiB for the largest size, not worth spending on a bad model.
   Result<Framebuffer> framebuffer = Framebuffer::create(spec.width, spec.height);

@@ -4,6 +4,8 @@
 // (runtime errors). Nothing is rendered or written before both have succeeded.
 #pragma once
 
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -15,6 +17,7 @@
 #include "softrast/mesh.hpp"
 #include "softrast/renderer.hpp"
 #include "softrast/status.hpp"
+#include "softrast/texture.hpp"
 
 namespace softrast::cli {
 
@@ -55,7 +58,14 @@ struct Job {
   bool quiet = false;
 };
 
+// How prepare() reads files; `softrast batch` passes loaders that keep what its jobs share. An
+// empty function means the usual reader (load_obj, load_image).
+struct Loaders {
+  std::function<Result<Mesh>(const std::string& path)> model;
+  std::function<Result<std::shared_ptr<const Texture>>(const std::string& path)> texture;
+};
+
 Result<JobSpec> interpret(const RawArgs& args);
-Result<Job> prepare(const JobSpec& spec);
+Result<Job> prepare(const JobSpec& spec, const Loaders& loaders = {});
 
 }  // namespace softrast::cli

@@ -1,0 +1,279 @@
+// apps/softrast/info.cpp: the info command. Geometry comes from load_obj (what the renderer
+// draws); the files a model refers to come from a scan of its mtllib statements and of the MTL
+// libraries' newmtl and map statements, so that a missing file is listed even when it stops the
+// model from loading.
+
+#include "info.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <string_view>
+
+#include <glm/common.hpp>
+#include <glm/vec3.hpp>
+#include <nlohmann/json.hpp>
+
+#include "report.hpp"
+#include "softrast/mesh.hpp"
+
+namespace softrast::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using ojson = nlohmann::ordered_json;
+
+// A file named inside a model: an MTL library or a texture map.
+struct Reference {
+  std::string kind;  // "mtllib", "map_Kd", "bump", ...
+  std::string path;  // as written
+  fs::path resolved;
+  bool found = false;
+};
+
+struct ScannedMaterial {
+  std::string name;
+  std::vector<Reference> maps;
+};
+
+// Statement counts and references, read from the text (whatever load_obj makes of it).
+struct Scan {
+  size_t positions = 0, texcoords = 0, normals = 0, faces = 0;
+  std::vector<Reference> libraries;
+  std::vector<ScannedMaterial> materials;
+};
+
+std::vector<std::string_view> words_of(std::string_view line) {
+  std::vector<std::string_view> words;
+  size_t at = 0;
+  while (true) {
+    at = line.find_first_not_of(" \t\r", at);
+    if (at == line.npos) break;
+    size_t end = std::min(line.find_first_of(" \t\r", at), line.size());
+    words.push_back(line.substr(at, end - at));
+    at = end;
+  }
+  return words;
+}
+
+Reference reference(std::string kind, std::string_view path, const fs::path& folder) {
+  Reference r{std::move(kind), std::string(path), folder / std::string(path), false};
+  std::error_code ec;
+  r.found = fs::is_regular_file(r.resolved, ec);
+  return r;
+}
+
+// Map statements: map_Kd, map_Bump, ... and the older bump, disp, decal, refl, norm. The file is
+// the last word (options such as -s 1 1 1 come before it).
+bool is_map(std::string_view keyword) {
+  return keyword.rfind("map_", 0) == 0 || keyword == "bump" || keyword == "disp" ||
+         keyword == "decal" || keyword == "refl" || keyword == "norm";
+}
+
+void scan_library(const Reference& library, Scan& scan) {
+  std::ifstream in(library.resolved);
+  std::string line;
+  fs::path folder = library.resolved.parent_path();
+  while (std::getline(in, line)) {
+    std::vector<std::string_view> w = words_of(line);
+    if (w.size() >= 2 && w[0] == "newmtl") scan.materials.push_back({std::string(w[1]), {}});
+    if (w.size() >= 2 && is_map(w[0]) && !scan.materials.empty()) {
+      scan.materials.back().maps.push_back(reference(std::string(w[0]), w.back(), folder));
+    }
+  }
+}
+
+Scan scan_model(const std::string& path) {
+  Scan scan;
+  std::ifstream in(path);
+  std::string line;
+  fs::path folder = fs::path(path).parent_path();
+  while (std::getline(in, line)) {
+    std::vector<std::string_view> w = words_of(line);
+    if (w.empty()) continue;
+    if (w[0] == "v") ++scan.positions;
+    if (w[0] == "vt") ++scan.texcoords;
+    if (w[0] == "vn") ++scan.normals;
+    if (w[0] == "f") ++scan.faces;
+    if (w[0] == "mtllib") {
+      for (size_t i = 1; i < w.size(); ++i)
+        scan.libraries.push_back(reference("mtllib", w[i], folder));
+    }
+  }
+  for (const Reference& library : scan.libraries) {
+    if (library.found) scan_library(library, scan);
+  }
+  return scan;
+}
+
+ojson vec3_json(glm::vec3 v) {
+  return ojson::array({rounded(v.x, 6), rounded(v.y, 6), rounded(v.z, 6)});
+}
+
+ojson reference_json(const Reference& r) {
+  return {
+      {"kind", r.kind}, {"path", r.path}, {"resolved", r.resolved.string()}, {"found", r.found}};
+}
+
+const Material* material_named(const Mesh* mesh, const std::string& name) {
+  if (!mesh) return nullptr;
+  for (const Material& m : mesh->materials) {
+    if (m.name == name) return &m;
+  }
+  return nullptr;
+}
+
+ojson materials_json(const Scan& scan, const Mesh* mesh) {
+  ojson materials = ojson::array();
+  for (const ScannedMaterial& s : scan.materials) {
+    ojson m = {{"name", s.name}};
+    if (const Material* loaded = material_named(mesh, s.name)) {
+      m["diffuse"] = vec3_json(loaded->diffuse);
+      m["diffuse_map_loaded"] = loaded->diffuse_map != nullptr;
+    }
+    ojson maps = ojson::array();
+    for (const Reference& r : s.maps) maps.push_back(reference_json(r));
+    m["maps"] = std::move(maps);
+    materials.push_back(std::move(m));
+  }
+  return materials;
+}
+
+ojson geometry_json(const Mesh& mesh) {
+  glm::vec3 lo(std::numeric_limits<float>::infinity()), hi = -lo;
+  for (glm::vec3 p : mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  ojson submeshes = ojson::array();
+  for (const SubMesh& s : mesh.submeshes) {
+    bool named = s.material >= 0 && size_t(s.material) < mesh.materials.size();
+    submeshes.push_back(
+        {{"material", named ? ojson(mesh.materials[size_t(s.material)].name) : ojson(nullptr)},
+         {"triangles", s.index_count / 3}});
+  }
+  if (mesh.submeshes.empty()) {
+    submeshes.push_back({{"material", nullptr}, {"triangles", mesh.triangle_count()}});
+  }
+  return {{"triangles", mesh.triangle_count()},
+          {"vertices", mesh.vertex_count()},
+          {"bounds",
+           {{"min", vec3_json(lo)},
+            {"max", vec3_json(hi)},
+            {"size", vec3_json(hi - lo)},
+            {"center", vec3_json((lo + hi) * 0.5f)}}},
+          {"submeshes", std::move(submeshes)}};
+}
+
+// Everything known about one model; "error" when it does not load.
+ojson describe(const std::string& path) {
+  ojson info = {{"model", path}};
+  Result<Mesh> mesh = load_obj(path);
+  if (!mesh) info["error"] = mesh.status().message();
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return info;
+  Scan scan = scan_model(path);
+  if (mesh) info.update(geometry_json(*mesh));
+  info["file"] = {{"positions", scan.positions},
+                  {"texcoords", scan.texcoords},
+                  {"normals", scan.normals},
+                  {"faces", scan.faces}};
+  ojson libraries = ojson::array();
+  for (const Reference& r : scan.libraries) libraries.push_back(reference_json(r));
+  info["libraries"] = std::move(libraries);
+  info["materials"] = materials_json(scan, mesh ? &*mesh : nullptr);
+  return info;
+}
+
+std::string number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+std::string triple(const ojson& v) {
+  return number(v[0].get<double>()) + " " + number(v[1].get<double>()) + " " +
+         number(v[2].get<double>());
+}
+
+std::string found_text(const ojson& r) {
+  return r["path"].get<std::string>() + (r["found"].get<bool>() ? " (found)" : " (MISSING)");
+}
+
+void print_geometry(const ojson& info) {
+  const ojson& f = info["file"];
+  std::printf("  triangles  %s\n", info["triangles"].dump().c_str());
+  std::printf(
+      "  vertices   %s (the file: %s positions, %s texture coordinates, %s normals, %s "
+      "faces)\n",
+      info["vertices"].dump().c_str(), f["positions"].dump().c_str(), f["texcoords"].dump().c_str(),
+      f["normals"].dump().c_str(), f["faces"].dump().c_str());
+  const ojson& b = info["bounds"];
+  std::printf("  bounds     min %s  max %s  size %s  center %s\n", triple(b["min"]).c_str(),
+              triple(b["max"]).c_str(), triple(b["size"]).c_str(), triple(b["center"]).c_str());
+  std::printf("  submeshes  %zu\n", info["submeshes"].size());
+  for (const ojson& s : info["submeshes"]) {
+    std::string name =
+        s["material"].is_null() ? "(default material)" : s["material"].get<std::string>();
+    std::printf("    %s: %s triangles\n", name.c_str(), s["triangles"].dump().c_str());
+  }
+}
+
+void print_references(const ojson& info) {
+  for (const ojson& r : info["libraries"]) std::printf("  mtllib     %s\n", found_text(r).c_str());
+  std::printf("  materials  %zu\n", info["materials"].size());
+  for (const ojson& m : info["materials"]) {
+    std::string kd = m.contains("diffuse") ? "  Kd " + triple(m["diffuse"]) : "";
+    std::printf("    %s%s\n", m["name"].get<std::string>().c_str(), kd.c_str());
+    for (const ojson& r : m["maps"]) {
+      std::printf("      %s %s\n", r["kind"].get<std::string>().c_str(), found_text(r).c_str());
+    }
+  }
+}
+
+void print_text(const ojson& info) {
+  std::printf("%s\n", info["model"].get<std::string>().c_str());
+  if (info.contains("triangles")) print_geometry(info);
+  if (info.contains("libraries")) print_references(info);
+}
+
+}  // namespace
+
+void define_info_flags(CLI::App& app, InfoArgs& a) {
+  app.add_option("MODEL", a.models, "Wavefront OBJ files")->required();
+  app.add_flag("--json", a.json,
+               "One JSON object per model and line: model, triangles, vertices, bounds (min, max, "
+               "size, center), submeshes, file (statement counts), libraries and materials with "
+               "their maps (path, resolved, found), or error");
+  app.footer(
+      "Vertices are the mesh's (one per distinct position/normal/uv corner), triangles after "
+      "fan triangulation. Files a model names are looked up as the loader does (MTL libraries "
+      "beside the OBJ, maps beside their MTL) and marked found or MISSING; only map_Kd is "
+      "drawn.\n\n"
+      "Examples:\n"
+      "  softrast info model.obj\n"
+      "  softrast info assets/*.obj --json | jq .triangles");
+}
+
+int info_command(const InfoArgs& args) {
+  bool all_loaded = true;
+  for (const std::string& path : args.models) {
+    ojson info = describe(path);
+    if (info.contains("error")) {
+      print_error(info["error"].get<std::string>());
+      all_loaded = false;
+    }
+    if (args.json) {
+      if (!print_line(info.dump(-1, ' ', false, ojson::error_handler_t::replace))) {
+        print_error("cannot write the results to the standard output");
+        return kExitRuntime;
+      }
+    } else {
+      print_text(info);
+    }
+  }
+  std::fflush(stdout);
+  return all_loaded ? 0 : kExitRuntime;
+}
+
+}  // namespace softrast::cli
