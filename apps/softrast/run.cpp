@@ -34,10 +34,12 @@ std::string size_text(const Job& job) {
   return std::to_string(job.framebuffer.width()) + "x" + std::to_string(job.framebuffer.height());
 }
 
-// One frame as SCENES.md defines it: clear colour and depth, draw everything. Milliseconds.
+// One frame as SCENES.md defines it: clear colour (--background) and depth, draw everything.
+// Milliseconds.
 double render_frame(Job& job) {
   auto start = std::chrono::steady_clock::now();
-  job.framebuffer.clear();
+  job.framebuffer.clear_color(job.background);
+  job.framebuffer.clear_depth();
   render_mesh(job.framebuffer, job.scene.mesh, job.scene.camera, job.options);
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
@@ -122,6 +124,10 @@ Status write_image(const Job& job) {
 }  // namespace
 
 Status run_job(Job& job) {
+  // Warnings are not progress: printed even with --quiet.
+  for (const std::string& warning : job.scene.warnings) {
+    std::fprintf(stderr, "softrast: warning: %s\n", warning.c_str());
+  }
   progress(job, "loaded " + job.scene.source + ": " +
                     std::to_string(job.scene.mesh.triangle_count()) + " triangles in " +
                     format("%.1f", job.scene.load_ms) + " ms");
