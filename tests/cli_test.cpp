@@ -235,8 +235,9 @@ TEST_F(CliTest, TextureShaderShowsTheTexture) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   Image image = load("t.png", 64, 64);
   EXPECT_FALSE(all_one_colour(image));
-  // Texture row 0 (top) has green; v = 1 is the top of the square.
-  EXPECT_EQ(pixel(image, 26, 26)[1], 255);
+  // Texture row 0 (top) has green; v = 1 is the top of the square (which fills 90% of the
+  // image: the middle of its top-left quarter is at pixel 17, 17).
+  EXPECT_EQ(pixel(image, 17, 17)[1], 255);
 }
 
 TEST_F(CliTest, LightFlagSetsTheWorldSpaceLightDirection) {
@@ -280,13 +281,21 @@ TEST_F(CliTest, WireframeOverlayDiagonalIsSolid) {
   int wire = to_unorm8(0.05f);
   auto is_wire = [&](int x, int y) { return pixel(image, x, y)[0] == wire; };
   auto is_surface = [&](int x, int y) { return pixel(image, x, y)[0] == to_unorm8(0.9f); };
-  // The floor's columns, and in the middle 60 % of them (away from the corners the diagonal
-  // ends in) a wire pixel with the surface three rows above and below.
+  // The columns the diagonal crosses, from the floor's top-left corner (its leftmost pixel in
+  // its top row) to its bottom-right one (the rightmost in its bottom row), and in the middle
+  // 60 % of them (away from the corners the diagonal ends in) a wire pixel with the surface
+  // three rows above and below.
+  int top = -1, bottom = -1;
+  for (int y = 0; y < 300; ++y) {
+    for (int x = 0; x < 400; ++x) {
+      if (is_surface(x, y)) bottom = y, top = top < 0 ? y : top;
+    }
+  }
+  ASSERT_GE(top, 0);
   int left = 400, right = -1;
   for (int x = 0; x < 400; ++x) {
-    for (int y = 0; y < 300; ++y) {
-      if (is_surface(x, y)) left = std::min(left, x), right = std::max(right, x);
-    }
+    if (is_surface(x, top)) left = std::min(left, x);
+    if (is_surface(x, bottom)) right = std::max(right, x);
   }
   int columns = 0, with_wire = 0;
   for (int x = left + (right - left) / 5; x <= right - (right - left) / 5; ++x) {

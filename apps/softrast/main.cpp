@@ -94,7 +94,7 @@ int help_command(CLI::App& app, const std::vector<std::string>& words) {
   std::string names;
   for (CLI::App* command : commands) {
     if (command->get_name() == name && words.size() <= 2) {
-      std::fputs(command->help().c_str(), stdout);
+      std::fputs(command->help(app.get_name()).c_str(), stdout);
       return 0;
     }
     names += (names.empty() ? "" : ", ") + command->get_name();
