@@ -49,7 +49,8 @@ int channel(const Image& image, int x, int y, int c) {
 // The largest channel difference between two images of the same size.
 int worst_difference(const Image& a, const Image& b) {
   int worst = 0;
-  for (size_t i = 0; i < a.rgba.size(); ++i) worst = std::max(worst, std::abs(a.rgba[i] - b.rgba[i]));
+  for (size_t i = 0; i < a.rgba.size(); ++i)
+    worst = std::max(worst, std::abs(a.rgba[i] - b.rgba[i]));
   return worst;
 }
 
@@ -121,12 +122,16 @@ TEST(CliLight, AmbientAndIntensityScaleTheTerms) {
 
 // ---------------------------------------------------------------------------------------------
 // The depth view spreads its ramp over the depths in the image: a floor seen at a slant has
-// its nearest pixels (bottom rows) white and its farthest (top rows) black.
+// its nearest pixels (bottom rows) white and its farthest (top rows) black, whatever the near
+// and far planes.
 
 TEST(CliDepthView, RampSpansTheVisibleDepths) {
   CliFolder folder;
   folder.write("floor.obj", "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nf 3 2 1\nf 4 3 1\n");
-  Image image = folder.render("floor.obj --shader depth --size 160x120 --background 0,0,1");
+  // Near and far planes far beyond the floor: the camera's range would leave it mid-grey.
+  Image image = folder.render(
+      "floor.obj --shader depth --size 160x120 --background 0,0,1 --eye 0,1.5,2.5 "
+      "--target 0,0,0 --near 0.1 --far 100");
   ASSERT_FALSE(image.rgba.empty());
   int top = -1, bottom = -1;  // the first and last rows with floor pixels
   int lightest = 0, darkest = 255;
@@ -278,8 +283,8 @@ TEST(CliFraming, AnglesUpAxesAndZoom) {
   for (const char* flags :
        {"--azimuth 30 --elevation 20", "--azimuth -150 --elevation -60", "--up-axis +z",
         "--up-axis -x --view iso", "--fov 20 --view right", "--fov 100 --view top"}) {
-    std::string args = std::string("part.obj --shader flat --background 0,0,0 --size 160x90 ") +
-                       flags;
+    std::string args =
+        std::string("part.obj --shader flat --background 0,0,0 --size 160x90 ") + flags;
     expect_framed(folder.render(args), args);
   }
   // --zoom 0.5 halves the extent along the limiting side (within a pixel or two).

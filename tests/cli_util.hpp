@@ -41,8 +41,7 @@ inline std::string read_whole_file(const std::filesystem::path& path) {
 class CliFolder {
  public:
   CliFolder() {
-    std::string pattern =
-        (std::filesystem::temp_directory_path() / "softrast_cli_XXXXXX").string();
+    std::string pattern = (std::filesystem::temp_directory_path() / "softrast_cli_XXXXXX").string();
     if (::mkdtemp(pattern.data()) != nullptr) root_ = pattern;
     std::filesystem::create_directories(root_ / "work");
   }
@@ -64,10 +63,9 @@ class CliFolder {
   // Runs `softrast ARGS` (ARGS as typed in a shell) in the folder.
   CliResult run(const std::string& args) const {
     std::filesystem::path out = root_ / "stdout", err = root_ / "stderr";
-    std::string command = "cd " + shell_quote(dir().string()) + " && " +
-                          shell_quote(SOFTRAST_CLI_PATH) + " " + args + " >" +
-                          shell_quote(out.string()) + " 2>" + shell_quote(err.string()) +
-                          " </dev/null";
+    std::string command =
+        "cd " + shell_quote(dir().string()) + " && " + shell_quote(SOFTRAST_CLI_PATH) + " " + args +
+        " >" + shell_quote(out.string()) + " 2>" + shell_quote(err.string()) + " </dev/null";
     int status = std::system(command.c_str());
     CliResult result;
     if (status != -1 && WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);

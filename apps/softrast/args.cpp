@@ -80,7 +80,8 @@ void define_shading_flags(CLI::App& app, RawArgs& a) {
                  "Direction towards the light, fixed in world space (default: a headlight, "
                  "0.3,0.5,0.8 in the camera's frame, so any view is lit from its upper left)")
       ->type_name("X,Y,Z");
-  app.add_option("--ambient", a.ambient, "Ambient light of gouraud and phong, 0 to 1 (default 0.15)")
+  app.add_option("--ambient", a.ambient,
+                 "Ambient light of gouraud and phong, 0 to 1 (default 0.15)")
       ->type_name("A");
   app.add_option("--light-intensity", a.light_intensity,
                  "Strength of the diffuse and specular light, 0 to 100 (default 1)")

@@ -31,8 +31,8 @@ std::string view_names();
 struct CameraFlags {
   std::optional<glm::vec3> eye, target, up;
   std::optional<float> fov, near_plane, far_plane;
-  std::optional<glm::vec4> ortho;  // left, right, bottom, top
-  glm::vec3 up_axis{0.0f, 1.0f, 0.0f};  // the model's up direction, a unit axis
+  std::optional<glm::vec4> ortho;           // left, right, bottom, top
+  glm::vec3 up_axis{0.0f, 1.0f, 0.0f};      // the model's up direction, a unit axis
   std::optional<float> azimuth, elevation;  // --view's, replaced by --azimuth / --elevation
   float zoom = 1.0f;
 };

@@ -20,8 +20,8 @@
 #include "args.hpp"
 #include "run.hpp"
 #include "setup.hpp"
-#include "values.hpp"
 #include "softrast/image.hpp"
+#include "values.hpp"
 
 namespace {
 
@@ -100,8 +100,7 @@ int help_command(CLI::App& app, const std::vector<std::string>& words) {
     names += (names.empty() ? "" : ", ") + command->get_name();
   }
   report_error(words.size() > 2 ? "help: expected at most one command (" + names + ")"
-                                 : "help: unknown command '" + name + "' (commands: " + names +
-                                       ")");
+                                : "help: unknown command '" + name + "' (commands: " + names + ")");
   return kExitUsage;
 }
 

@@ -29,13 +29,13 @@ bool is_model_file(const fs::directory_entry& entry) {
   std::error_code ec;
   if (!entry.is_regular_file(ec)) return false;
   std::string ext = lowercase(entry.path().extension().string());
-  return std::find(kModelExtensions.begin(), kModelExtensions.end(), ext) !=
-         kModelExtensions.end();
+  return std::find(kModelExtensions.begin(), kModelExtensions.end(), ext) != kModelExtensions.end();
 }
 
 std::string extension_list() {
   std::string list;
-  for (std::string_view ext : kModelExtensions) list += (list.empty() ? "" : ", ") + std::string(ext);
+  for (std::string_view ext : kModelExtensions)
+    list += (list.empty() ? "" : ", ") + std::string(ext);
   return list;
 }
 
@@ -136,9 +136,8 @@ std::vector<std::string> texture_warnings(const std::vector<ModelPart>& parts,
   bool textured_shader =
       options.shader == ShaderKind::kTexture || options.shader == ShaderKind::kPhong;
   if (!textured_shader) return warnings;
-  bool any_map = std::any_of(parts.begin(), parts.end(), [](const ModelPart& p) {
-    return p.has_maps;
-  });
+  bool any_map =
+      std::any_of(parts.begin(), parts.end(), [](const ModelPart& p) { return p.has_maps; });
   if (options.shader == ShaderKind::kTexture && !texture_flag && !any_map) {
     warnings.push_back(
         "--shader texture: the model has no texture (no --texture, no map_Kd in its "

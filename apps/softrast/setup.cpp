@@ -19,9 +19,9 @@
 #include <memory>
 #include <utility>
 
+#include "scene_files.hpp"
 #include "softrast/image.hpp"
 #include "softrast/texture.hpp"
-#include "scene_files.hpp"
 #include "values.hpp"
 
 namespace softrast::cli {
@@ -108,11 +108,11 @@ constexpr int kMaxThreads = 1024;
 constexpr float kMaxLightIntensity = 100.0f;
 
 const std::array<Named<glm::vec3>, 6> kUpAxes = {{{"+x", {1.0f, 0.0f, 0.0f}},
-                                                     {"-x", {-1.0f, 0.0f, 0.0f}},
-                                                     {"+y", {0.0f, 1.0f, 0.0f}},
-                                                     {"-y", {0.0f, -1.0f, 0.0f}},
-                                                     {"+z", {0.0f, 0.0f, 1.0f}},
-                                                     {"-z", {0.0f, 0.0f, -1.0f}}}};
+                                                  {"-x", {-1.0f, 0.0f, 0.0f}},
+                                                  {"+y", {0.0f, 1.0f, 0.0f}},
+                                                  {"-y", {0.0f, -1.0f, 0.0f}},
+                                                  {"+z", {0.0f, 0.0f, 1.0f}},
+                                                  {"-z", {0.0f, 0.0f, -1.0f}}}};
 
 void interpret_state(const RawArgs& a, RenderState& state, FirstError& e) {
   e.take(lookup<CullMode>("--cull", kCullModes, a.cull), state.cull);

@@ -176,11 +176,10 @@ struct DepthShader {
   glm::mat4 view{1.0f};
   bool logarithmic = true;
   float g_nearest = 0.0f;
-  float g_scale = 1.0f;  // 1 / (g(farthest) - g(nearest))
+  float g_scale = 1.0f;   // 1 / (g(farthest) - g(nearest))
   float floor = 1.0e-6f;  // the smallest depth put through the log
 
-  DepthShader(const MeshInputs& inputs, const glm::mat4& view_matrix, float nearest,
-              float farthest)
+  DepthShader(const MeshInputs& inputs, const glm::mat4& view_matrix, float nearest, float farthest)
       : in(inputs), view(view_matrix), logarithmic(nearest > 0.0f) {
     if (logarithmic) floor = nearest * 0.5f;
     float g_far = g(farthest);

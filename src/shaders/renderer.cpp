@@ -88,8 +88,8 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
     case ShaderKind::kNormals:
       return draw(fb, state, NormalsShader{in}, indices, n);
     case ShaderKind::kDepth:
-      return draw(fb, state, DepthShader(in, camera.view(), depth.nearest, depth.farthest),
-                  indices, n);
+      return draw(fb, state, DepthShader(in, camera.view(), depth.nearest, depth.farthest), indices,
+                  n);
   }
 }
 
@@ -173,14 +173,13 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
   });
   DepthRange depth{camera.near_plane, camera.far_plane};
   if (options.shader == ShaderKind::kDepth) {
-    depth = visible_depth_range(framebuffer.width(), framebuffer.height(), mesh, camera, mvp,
-                                runs, state);
+    depth = visible_depth_range(framebuffer.width(), framebuffer.height(), mesh, camera, mvp, runs,
+                                state);
   }
   for (const SubMesh& run : runs) {
     std::span<const uint32_t> indices(mesh.indices.data() + run.first_index, run.index_count);
     Surface surf = surface_of(mesh, run.material, options);
-    draw_run(framebuffer, state, mesh, camera, mvp, indices, surf, options, options.shader,
-             depth);
+    draw_run(framebuffer, state, mesh, camera, mvp, indices, surf, options, options.shader, depth);
   }
   if (options.wireframe_overlay && options.shader != ShaderKind::kWireframe) {
     RenderState wire = options.state;
