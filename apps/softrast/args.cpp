@@ -19,7 +19,7 @@ void define_output_flags(CLI::App& app, RawArgs& a) {
   app.add_option("--frames", a.frames,
                  "Benchmark: time N frames after 2 warm-up frames, print one JSON line")
       ->type_name("N");
-  app.add_flag("-q,--quiet", a.quiet, "No progress messages on stderr");
+  app.add_flag("-q,--quiet", a.quiet, "No progress messages or warnings on stderr");
 }
 
 void define_camera_flags(CLI::App& app, RawArgs& a) {

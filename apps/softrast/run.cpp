@@ -124,9 +124,12 @@ Status write_image(const Job& job) {
 }  // namespace
 
 Status run_job(Job& job) {
-  // Warnings are not progress: printed even with --quiet.
-  for (const std::string& warning : job.scene.warnings) {
-    std::fprintf(stderr, "softrast: warning: %s\n", warning.c_str());
+  // What the render works around (a texture that cannot show, a file a model names that is
+  // missing), before the progress lines; --quiet silences these too.
+  if (!job.quiet) {
+    for (const std::string& warning : job.scene.warnings) {
+      std::fprintf(stderr, "softrast: warning: %s\n", warning.c_str());
+    }
   }
   progress(job, "loaded " + job.scene.source + ": " +
                     std::to_string(job.scene.mesh.triangle_count()) + " triangles in " +

@@ -15,8 +15,10 @@ namespace {
 namespace fs = std::filesystem;
 
 // The extensions a folder's model files have (compared in lower case).
-// TODO(lead): add ".ply" and ".stl" here once the loader reads them (the io branch), and call
-// its format-dispatching loader in load_one() below.
+// TODO(lead, merging the io branch): add ".ply" and ".stl" here and call its load_model() (which
+// tells the formats apart by content) instead of load_obj() in load_models(); its Mesh::warnings
+// then reach Scene::warnings through take_loader_warnings(), so the io branch's own printing of
+// them in setup.cpp's load_scene() goes.
 constexpr std::array<std::string_view, 1> kModelExtensions = {".obj"};
 
 std::string lowercase(std::string text) {
@@ -59,7 +61,6 @@ void take_loader_warnings(const M& mesh, std::vector<std::string>& out) {
   if constexpr (requires { mesh.warnings; }) {
     for (const auto& w : mesh.warnings) out.push_back(std::string(w));
   }
-  // TODO(lead): nothing to do once Mesh::warnings exists (the io branch): they are printed.
 }
 
 bool has_varying_uvs(const Mesh& mesh) {
