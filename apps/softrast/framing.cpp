@@ -174,15 +174,10 @@ glm::vec3 fit_eye(const Mesh& mesh, const ViewFrame& view, float kx, float ky,
   return cx * view.right + cy * view.up + cz * view.back;
 }
 
-// Near and far planes that enclose every vertex seen from `eye` looking towards `target`; an
-// automatic value that contradicts a given one gives way to it.
-void set_depth_range(Camera& camera, const Mesh& mesh, const CameraFlags& flags) {
-  glm::vec3 forward = glm::normalize(camera.target - camera.eye);
-  float lo = std::numeric_limits<float>::max(), hi = -lo;
-  for (const glm::vec3& p : mesh.positions) {
-    float d = glm::dot(p - camera.eye, forward);
-    lo = std::min(lo, d), hi = std::max(hi, d);
-  }
+// Near and far for a scene spanning the distances [lo, hi] in front of the eye (along the view
+// direction), with a margin, from the flags where given; an automatic value that contradicts a
+// given one gives way to it.
+void set_depth_range(Camera& camera, float lo, float hi, const CameraFlags& flags) {
   float margin = kDepthMargin * std::max(hi - lo, 1.0e-3f * std::abs(hi)) + 1.0e-6f;
   float far_plane = std::max(hi + margin, 1.0e-3f);
   float near_plane = std::max(lo - margin, far_plane * kMinNearRatio);
@@ -195,6 +190,17 @@ void set_depth_range(Camera& camera, const Mesh& mesh, const CameraFlags& flags)
   }
   camera.near_plane = flags.near_plane.value_or(near_plane);
   camera.far_plane = flags.far_plane.value_or(far_plane);
+}
+
+// The distances every vertex spans in front of the camera.
+std::pair<float, float> vertex_depths(const Camera& camera, const Mesh& mesh) {
+  glm::vec3 forward = glm::normalize(camera.target - camera.eye);
+  float lo = std::numeric_limits<float>::max(), hi = -lo;
+  for (const glm::vec3& p : mesh.positions) {
+    float d = glm::dot(p - camera.eye, forward);
+    lo = std::min(lo, d), hi = std::max(hi, d);
+  }
+  return {lo, hi};
 }
 
 }  // namespace
@@ -235,7 +241,35 @@ Camera frame_model(const Mesh& mesh, const CameraFlags& flags, float aspect) {
       camera.target = camera.eye - view.back * std::max(distance, 1.0e-6f);
     }
   }
-  set_depth_range(camera, mesh, flags);
+  auto [lo, hi] = vertex_depths(camera, mesh);
+  set_depth_range(camera, lo, hi, flags);
+  return camera;
+}
+
+Bounds bounds_of(const Mesh& mesh) {
+  if (mesh.positions.empty()) return {};
+  Bounds bounds;
+  bounds.center = center_of(mesh);
+  bounds.radius = radius_of(mesh, bounds.center);
+  bounds.flat_in_y = flat_along(mesh, glm::vec3(0.0f, 1.0f, 0.0f));
+  return bounds;
+}
+
+Camera frame_model(const Bounds& bounds, const CameraFlags& flags, float aspect) {
+  Camera camera;
+  apply_flags(camera, flags);
+  camera.target = flags.target.value_or(bounds.center);
+  float distance = 2.0f * bounds.radius;  // any distance outside suits an orthographic camera
+  if (!camera.orthographic) {
+    float half_y = radians(camera.fov_y_degrees) * 0.5f;
+    float half_x = std::atan(std::tan(half_y) * aspect);
+    distance = bounds.radius / std::sin(std::min(half_y, half_x));
+  }
+  glm::vec3 direction =
+      bounds.flat_in_y ? glm::normalize(glm::vec3(0.0f, 1.0f, 1.0f)) : glm::vec3(0.0f, 0.0f, 1.0f);
+  camera.eye = flags.eye.value_or(camera.target + direction * distance);
+  float to_center = glm::length(camera.eye - bounds.center);
+  set_depth_range(camera, to_center - bounds.radius, to_center + bounds.radius, flags);
   return camera;
 }
 

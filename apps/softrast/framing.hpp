@@ -45,6 +45,20 @@ inline constexpr float kFrameFill = 0.9f;
 // adapt to it.
 Camera frame_model(const Mesh& mesh, const CameraFlags& flags, float aspect);
 
+// The sphere around the axis-aligned bounding box of the positions (radius > 0; 1 for an empty
+// or single-point mesh), for callers that move a camera around a scene without its vertices.
+struct Bounds {
+  glm::vec3 center{0.0f};
+  float radius = 1.0f;
+  bool flat_in_y = false;  // height under a tenth of the width and depth: a ground plane
+};
+Bounds bounds_of(const Mesh& mesh);
+
+// The bounding sphere's framing: from +z (45 degrees up for a model flat in y) at the distance
+// where the sphere fits the narrower field of view; with the eye and target given, only near and
+// far (around the sphere) are chosen. Looser than frame_model(mesh) above.
+Camera frame_model(const Bounds& bounds, const CameraFlags& flags, float aspect);
+
 // Replaces the settings of `camera` that `flags` gives.
 void apply_flags(Camera& camera, const CameraFlags& flags);
 
