@@ -628,6 +628,7 @@ const BadInput kBadInputs[] = {
     {"ZoomZero", "quad.obj --zoom 0 -o out.png"},
     {"ViewWithEye", "quad.obj --view top --eye 0,5,0 -o out.png"},
     {"ZoomWithEye", "quad.obj --zoom 2 --eye 0,0,5 -o out.png"},
+    {"ZoomWithOrtho", "quad.obj --zoom 2 --ortho -1,1,-1,1 -o out.png"},
     {"ViewOnTheDemoScene", "--view top -o out.png"},
     {"AmbientOutOfRange", "--ambient 1.5 -o out.png"},
     {"LightIntensityNegative", "--light-intensity=-1 -o out.png"},

@@ -202,6 +202,7 @@ void interpret_placement(const RawArgs& a, CameraFlags& c, FirstError& e) {
   if (a.zoom) {
     e.fail_if(!(*a.zoom > 0.0f && *a.zoom <= 1000.0f), "--zoom: must be in (0, 1000]");
     c.zoom = *a.zoom;
+    e.fail_if(a.ortho.has_value(), "--zoom: not with --ortho (its box sets the size)");
   }
   bool placed = a.view || a.azimuth || a.elevation || a.zoom;
   e.fail_if(a.eye && placed,
