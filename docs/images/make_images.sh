@@ -3,8 +3,10 @@
 # docs/images/. The models come from ../shared/models (not copied into the repository); the
 # half sphere and the Z-up and multi-part variants are written to a temporary folder.
 # Usage: docs/images/make_images.sh [NEW_SOFTRAST] [OLD_SOFTRAST]
-#   NEW: this tree's build (build/release/softrast); OLD: a build of main before issue 8's
-#   command-line work (88423b1), for the "before" images. Without OLD those are skipped.
+#   NEW: this tree's build (build/release/softrast); OLD: a build of main at f844599 (before
+#   issue 8's command-line work), for the "before" images. Without OLD those are skipped:
+#     git archive f844599 | tar -x -C /tmp/before && cd /tmp/before &&
+#     cmake --preset release && cmake --build --preset release --target softrast_cli
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 new=${1:-$here/../../build/release/softrast}
@@ -49,8 +51,8 @@ done
 # After: this tree.
 $new $head --texture "$head_tex" --view back $size -o "$out/head_back_after.png"
 $new $head --texture "$head_tex" --view right $size -o "$out/head_side_after.png"
-$new "$models/floor.obj" --texture "$models/floor_diffuse.tga" --wireframe --edge-color 1,1,0.3 \
-  $size -o "$out/floor_overlay_after.png"
+$new "$models/floor.obj" --texture "$models/floor_diffuse.tga" --wireframe $size \
+  -o "$out/floor_overlay_after.png"
 $new "$tmp/half_sphere.obj" --eye 1,-1.2,2.6 --target 0,0.3,0 $size -o "$out/half_sphere_after.png"
 $new "$tmp/head/african_head.obj" "$tmp/head/african_head_eye_inner.obj" --azimuth 25 \
   --elevation 10 $size -o "$out/head_parts_after.png"
@@ -59,13 +61,15 @@ $new "$tmp/diablo_z_up.obj" --texture "$diablo_tex" --up-axis +z --view iso $siz
   -o "$out/z_up_after.png"
 $new "$models/diablo3_pose/diablo3_pose.obj" --texture "$diablo_tex" --background 0,0,0,0 --size 160x160 -q -o "$out/thumbnail_transparent.png"
 
-# Before: main at 88423b1 with the light fixed in world space as it was before the headlight
-# (--light 0.3,0.5,0.8), its default culling (back) and framing.
+# Before: main at f844599, before issue 8's command-line work (light fixed in world space at
+# 0.3,0.5,0.8, back faces culled, the overlay depth-tested with a constant bias, framing of the
+# bounding sphere from +z). It has no --light, --view or --edge-color flags.
 if [ -n "$old" ]; then
-  $old $head --texture "$head_tex" --eye 0,0,-3 --light 0.3,0.5,0.8 $size -o "$out/head_back_before.png"
-  $old $head --texture "$head_tex" --eye 3,0,0 --light 0.3,0.5,0.8 $size -o "$out/head_side_before.png"
-  $old "$tmp/half_sphere.obj" --eye 1,-1.2,2.6 --target 0,0.3,0 --light 0.3,0.5,0.8 $size \
+  $old $head --texture "$head_tex" --eye 0,0,-3 $size -o "$out/head_back_before.png"
+  $old $head --texture "$head_tex" --eye 3,0,0 $size -o "$out/head_side_before.png"
+  $old "$models/floor.obj" --texture "$models/floor_diffuse.tga" --wireframe $size \
+    -o "$out/floor_overlay_before.png"
+  $old "$tmp/half_sphere.obj" --eye 1,-1.2,2.6 --target 0,0.3,0 $size \
     -o "$out/half_sphere_before.png"
-  $old "$tmp/diablo_z_up.obj" --texture "$diablo_tex" --light 0.3,0.5,0.8 $size \
-    -o "$out/z_up_before.png"
+  $old "$tmp/diablo_z_up.obj" --texture "$diablo_tex" $size -o "$out/z_up_before.png"
 fi
