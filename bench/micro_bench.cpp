@@ -52,10 +52,10 @@ Mesh sphere_grid(int columns, int rows, int slices, int stacks) {
 // The vertex stage: the built-in Gouraud vertex shader over a mesh's vertices.
 void BM_VertexShader(benchmark::State& state) {
   Mesh mesh = sphere_grid(16, 9, 32, 28);
-  detail::GouraudShader shader{{&mesh, glm::mat4(1.0f)},
-                               glm::vec3(0.9f, 0.6f, 0.3f),
-                               glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f)),
-                               1.0f};
+  detail::Lighting lighting;
+  lighting.light = glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f));
+  detail::GouraudShader<false> shader{
+      {&mesh, glm::mat4(1.0f)}, glm::vec3(0.9f, 0.6f, 0.3f), lighting, 1.0f};
   std::vector<float> out(mesh.positions.size() * 7);
   for (auto _ : state) {
     for (uint32_t i = 0; i < mesh.positions.size(); ++i) {

@@ -199,13 +199,14 @@ TEST_F(CliTest, ModelIsFramedAutomatically) {
 }
 
 TEST_F(CliTest, ExplicitCameraOverridesTheFraming) {
-  // From behind, the square is back-facing and culled: only the clear colour remains.
-  CliRun r = run("quad.obj --size 32x32 --eye 0,0,-5 --target 0,0,0 --up 0,1,0 -o back.png");
+  // From behind, the square is back-facing: drawn by default (--cull none), culled with
+  // --cull back, leaving only the clear colour.
+  CliRun r = run("quad.obj --size 32x32 --eye 0,0,-5 --target 0,0,0 --up 0,1,0 -o both.png");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_TRUE(all_one_colour(load("back.png", 32, 32)));
-  CliRun none = run("quad.obj --size 32x32 --eye 0,0,-5 --cull none -o both.png");
-  ASSERT_EQ(none.exit_code, 0) << none.err;
   EXPECT_FALSE(all_one_colour(load("both.png", 32, 32)));
+  CliRun back = run("quad.obj --size 32x32 --eye 0,0,-5 --cull back -o back.png");
+  ASSERT_EQ(back.exit_code, 0) << back.err;
+  EXPECT_TRUE(all_one_colour(load("back.png", 32, 32)));
 }
 
 TEST_F(CliTest, EveryRenderFlagIsAccepted) {
@@ -234,8 +235,9 @@ TEST_F(CliTest, TextureShaderShowsTheTexture) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   Image image = load("t.png", 64, 64);
   EXPECT_FALSE(all_one_colour(image));
-  // Texture row 0 (top) has green; v = 1 is the top of the square.
-  EXPECT_EQ(pixel(image, 26, 26)[1], 255);
+  // Texture row 0 (top) has green; v = 1 is the top of the square (which fills 90% of the
+  // image: the middle of its top-left quarter is at pixel 17, 17).
+  EXPECT_EQ(pixel(image, 17, 17)[1], 255);
 }
 
 TEST_F(CliTest, LightFlagSetsTheWorldSpaceLightDirection) {
@@ -279,13 +281,21 @@ TEST_F(CliTest, WireframeOverlayDiagonalIsSolid) {
   int wire = to_unorm8(0.05f);
   auto is_wire = [&](int x, int y) { return pixel(image, x, y)[0] == wire; };
   auto is_surface = [&](int x, int y) { return pixel(image, x, y)[0] == to_unorm8(0.9f); };
-  // The floor's columns, and in the middle 60 % of them (away from the corners the diagonal
-  // ends in) a wire pixel with the surface three rows above and below.
+  // The columns the diagonal crosses, from the floor's top-left corner (its leftmost pixel in
+  // its top row) to its bottom-right one (the rightmost in its bottom row), and in the middle
+  // 60 % of them (away from the corners the diagonal ends in) a wire pixel with the surface
+  // three rows above and below.
+  int top = -1, bottom = -1;
+  for (int y = 0; y < 300; ++y) {
+    for (int x = 0; x < 400; ++x) {
+      if (is_surface(x, y)) bottom = y, top = top < 0 ? y : top;
+    }
+  }
+  ASSERT_GE(top, 0);
   int left = 400, right = -1;
   for (int x = 0; x < 400; ++x) {
-    for (int y = 0; y < 300; ++y) {
-      if (is_surface(x, y)) left = std::min(left, x), right = std::max(right, x);
-    }
+    if (is_surface(x, top)) left = std::min(left, x);
+    if (is_surface(x, bottom)) right = std::max(right, x);
   }
   int columns = 0, with_wire = 0;
   for (int x = left + (right - left) / 5; x <= right - (right - left) / 5; ++x) {
@@ -337,6 +347,17 @@ TEST_F(CliTest, HelpMentionsEveryFlag) {
   EXPECT_EQ(files(), kFixtures);
 }
 
+TEST_F(CliTest, HelpMentionsTheFramingAndLightFlags) {
+  CliRun r = run("--help");
+  EXPECT_EQ(r.exit_code, 0);
+  const char* kFlags[] = {
+      "--ambient", "--light-intensity", "--edge-color", "--background", "--up-axis", "--view",
+      "--azimuth", "--elevation",       "--zoom",       "iso",          "+z",        "MODEL..."};
+  for (const char* flag : kFlags) {
+    EXPECT_NE(r.out.find(flag), std::string::npos) << "--help does not mention " << flag;
+  }
+}
+
 TEST_F(CliTest, VersionPrintsTheProgramName) {
   CliRun r = run("--version");
   EXPECT_EQ(r.exit_code, 0);
@@ -378,6 +399,109 @@ TEST_F(CliTest, FailureLeavesAnExistingOutputAlone) {
   CliRun r = run("missing.obj -o keep.png");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_EQ(read_file(work_dir() / "keep.png"), "old contents");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Messages, word for word.
+
+TEST_F(CliTest, UnknownFlagSuggestsTheClosestOne) {
+  CliRun r = run("quad.obj --shadr phong -o out.png");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err,
+            "softrast: error: unknown flag '--shadr'; did you mean --shader? (see softrast "
+            "--help)\n");
+  CliRun eq = run("quad.obj --backgruond=1,1,1 -o out.png");
+  EXPECT_EQ(eq.err,
+            "softrast: error: unknown flag '--backgruond'; did you mean --background? (see "
+            "softrast --help)\n");
+  CliRun far = run("quad.obj --bogus -o out.png");
+  EXPECT_EQ(far.err, "softrast: error: unknown flag '--bogus' (see softrast --help)\n");
+  EXPECT_EQ(files(), kFixtures);
+}
+
+TEST_F(CliTest, HelpCommandPrintsTheHelp) {
+  CliRun flag = run("--help");
+  ASSERT_EQ(flag.exit_code, 0);
+  for (const char* args : {"help", "help render"}) {
+    CliRun r = run(args);
+    EXPECT_EQ(r.exit_code, 0) << args;
+    EXPECT_EQ(r.out, flag.out) << args;
+    EXPECT_EQ(r.err, "") << args;
+  }
+  CliRun unknown = run("help paint");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_EQ(
+      unknown.err,
+      "softrast: error: help: unknown command 'paint' (commands: render, view, batch, info)\n");
+}
+
+TEST_F(CliTest, HelpExplainsMaterialsAndTheTwoDepths) {
+  CliRun r = run("--help");
+  ASSERT_EQ(r.exit_code, 0);
+  for (const char* sentence :
+       {"Materials: the MTL files an OBJ names (mtllib) are read, with each material's colour "
+        "(Kd) and texture (map_Kd); --texture overrides their maps.",
+        "Depth: --depth sets the depth test (which surface hides which); --shader depth is the "
+        "depth view (grey by distance, white nearest, black farthest).",
+        "depth is the depth view (grey by distance), not the depth test (--depth)",
+        "not the depth view (--shader depth)",
+        "The model's opacity, 0 to 1, written to the image's alpha channel",
+        "Background colour, alpha 0 for a transparent PNG"}) {
+    EXPECT_NE(r.out.find(sentence), std::string::npos) << "missing: " << sentence;
+  }
+}
+
+TEST_F(CliTest, VectorsAcceptSpacesAfterCommas) {
+  CliRun spaced = run("quad.obj --size 32x32 --eye '0, 0.5, 3' --color '0.2, 0.4, 0.6' -o a.png");
+  ASSERT_EQ(spaced.exit_code, 0) << spaced.err;
+  CliRun tight = run("quad.obj --size 32x32 --eye 0,0.5,3 --color 0.2,0.4,0.6 -o b.png");
+  ASSERT_EQ(tight.exit_code, 0) << tight.err;
+  EXPECT_EQ(read_file(work_dir() / "a.png"), read_file(work_dir() / "b.png"));
+}
+
+// The warning lines come first on stderr, before the progress lines; --quiet silences both.
+std::string warning_lines(const std::string& err) {
+  std::string lines;
+  size_t start = 0;
+  while (err.compare(start, 18, "softrast: warning:") == 0) {
+    size_t end = err.find('\n', start);
+    if (end == std::string::npos) break;
+    lines += err.substr(start, end + 1 - start);
+    start = end + 1;
+  }
+  return lines;
+}
+
+TEST_F(CliTest, TextureShaderWithoutTextureWarns) {
+  CliRun r = run("quad.obj --shader texture --size 16x16 -o out.png");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(warning_lines(r.err),
+            "softrast: warning: --shader texture: the model has no texture (no --texture, no "
+            "map_Kd in its materials), so it is drawn white\n");
+  CliRun quiet = run("quad.obj --shader texture --size 16x16 -q -o out.png");
+  EXPECT_EQ(quiet.err, "");
+  CliRun textured = run("quad.obj --shader texture --texture texture.png --size 16x16 -o t.png");
+  EXPECT_EQ(warning_lines(textured.err), "");
+  EXPECT_NE(textured.err, "");  // the progress lines are there
+}
+
+TEST_F(CliTest, TextureOnAModelWithoutUvsWarns) {
+  write("no_uvs.obj", "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n");
+  CliRun r = run("no_uvs.obj --texture texture.png --size 16x16 -o out.png");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(warning_lines(r.err),
+            "softrast: warning: no_uvs.obj: the model has no texture coordinates (vt), so its "
+            "texture shows as one colour\n");
+  CliRun untextured = run("no_uvs.obj --size 16x16 -o plain.png");
+  EXPECT_EQ(warning_lines(untextured.err), "");
+}
+
+TEST_F(CliTest, EmptyFolderIsAnError) {
+  fs::create_directories(work_dir() / "nothing");
+  write("nothing/notes.txt", "no models here\n");
+  CliRun r = run("nothing -o out.png");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err, "softrast: error: nothing: no model files (.obj) in this folder\n");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -496,7 +620,26 @@ const BadInput kBadInputs[] = {
     {"ModelEyeEqualsTarget", "quad.obj --eye 0,0,0 --target 0,0,0 -o out.png"},
     {"UnknownFlag", "--bogus -o out.png"},
     {"UnknownShortFlag", "-z -o out.png"},
-    {"TwoModels", "render quad.obj quad.obj -o out.png"},
+    {"SecondModelMissing", "render quad.obj missing.obj -o out.png"},
+    {"SecondModelEmpty", "render quad.obj empty.obj -o out.png"},
+    {"FolderWithoutModels", "render /dev -o out.png"},
+    {"UnknownView", "quad.obj --view above -o out.png"},
+    {"UnknownUpAxis", "quad.obj --up-axis z -o out.png"},
+    {"ElevationOutOfRange", "quad.obj --elevation 91 -o out.png"},
+    {"AzimuthNotANumber", "quad.obj --azimuth east -o out.png"},
+    {"ZoomZero", "quad.obj --zoom 0 -o out.png"},
+    {"ViewWithEye", "quad.obj --view top --eye 0,5,0 -o out.png"},
+    {"ZoomWithEye", "quad.obj --zoom 2 --eye 0,0,5 -o out.png"},
+    {"ZoomWithOrtho", "quad.obj --zoom 2 --ortho -1,1,-1,1 -o out.png"},
+    {"ViewOnTheDemoScene", "--view top -o out.png"},
+    {"AmbientOutOfRange", "--ambient 1.5 -o out.png"},
+    {"LightIntensityNegative", "--light-intensity=-1 -o out.png"},
+    {"EdgeColorOutOfRange", "--edge-color 0,0,2 -o out.png"},
+    {"EdgeColorWithAlpha", "--edge-color 0,0,0,1 -o out.png"},
+    {"BackgroundFiveNumbers", "--background 0,0,0,0,0 -o out.png"},
+    {"BackgroundOutOfRange", "--background 0,0,0,-1 -o out.png"},
+    {"HelpTwoCommands", "help render render"},
+    {"HelpUnknownCommand", "help paint"},
     {"UnknownShader", "--shader toon -o out.png"},
     {"UnknownCull", "--cull sideways -o out.png"},
     {"UnknownFrontFace", "--front-face up -o out.png"},

@@ -762,12 +762,14 @@ TEST_F(ReferenceDiffTest, ColourConversionDiffersOnlyOnTies) {
 // Scenes compared with tolerance.
 
 constexpr const char* kSmall = "--size 320x240";
+// The closed scenes cull back faces as SCENES.md's do; both programs draw both by default.
+constexpr const char* kCullBack = " --cull back";
 
 TEST_F(ReferenceDiffTest, TexturedQuadGridSeenAtAnAngle) {
   write("grid.obj", quad_grid_obj(8.0, 14.0, 16, 28));
   write_texture("checker.png", checker_texture(256));
-  std::string camera =
-      std::string(kSmall) + " --eye 0,3,3 --target 0,0,-4 --up 0,1,0 --fov 50 --near 0.5 --far 50";
+  std::string camera = std::string(kSmall) + kCullBack +
+                       " --eye 0,3,3 --target 0,0,-4 --up 0,1,0 --fov 50 --near 0.5 --far 50";
   expect_close("grid_texture", "grid.obj " + camera + " --shader texture --texture checker.png",
                kTextureThreshold, 40);
   expect_close("grid_phong", "grid.obj " + camera + " --shader phong --texture checker.png",
@@ -777,8 +779,8 @@ TEST_F(ReferenceDiffTest, TexturedQuadGridSeenAtAnAngle) {
 TEST_F(ReferenceDiffTest, LitSpheres) {
   write("spheres.obj", spheres_obj(4, 3, 24, 16, 0.45));
   write_texture("checker.png", checker_texture(128));
-  std::string camera =
-      std::string(kSmall) + " --eye 0,0,3.7 --target 0,0,0 --up 0,1,0 --fov 45 --near 1 --far 10";
+  std::string camera = std::string(kSmall) + kCullBack +
+                       " --eye 0,0,3.7 --target 0,0,0 --up 0,1,0 --fov 45 --near 1 --far 10";
   expect_close("spheres_gouraud", "spheres.obj " + camera + " --shader gouraud", kFlatThreshold,
                40);
   expect_close("spheres_phong", "spheres.obj " + camera + " --shader phong", kTextureThreshold, 40);
@@ -797,7 +799,7 @@ TEST_F(ReferenceDiffTest, FloorCrossingTheNearPlane) {
   obj.face({{a, ta, 0}, {b, tb, 0}, {c, tc, 0}, {d, td, 0}});
   write("floor.obj", obj.str());
   write_texture("checker.png", checker_texture(64));
-  std::string camera = std::string(kSmall) +
+  std::string camera = std::string(kSmall) + kCullBack +
                        " --eye 0.3,1,2 --target 0,0.2,-3 --up 0,1,0 --fov 60 --near 0.5 --far 40";
   expect_close("floor_flat", "floor.obj " + camera + " --shader flat", kFlatThreshold, 20);
   expect_close("floor_texture", "floor.obj " + camera + " --shader texture --texture checker.png",

@@ -377,13 +377,14 @@ TEST_F(ViewerUnderXvfb, WindowShowsTheFrameSoftrastRenderDrawsAfterMouseAndKeys)
   EXPECT_GT(glm::distance(panned.target, start.target), 0.01f * start.distance());
   EXPECT_NEAR(panned.distance(), zoomed.distance(), 1e-4f * start.distance());
 
-  // Then the shader (Tab: phong -> flat), the wireframe overlay (W), culling off (C) and edge
+  // Then the shader (Tab: phong -> flat), the wireframe overlay (W), culling on (C: back, the
+  // default being none) and edge
   // walking (R): the window shows what `softrast render` draws with the printed command.
   x("xdotool key --clearmodifiers Tab w c r");
   std::string moved = command_of_frame();
   ASSERT_FALSE(moved.empty());
   for (const char* expected :
-       {"--size 200x150 ", "--shader flat ", "--cull none ", "--raster scanline", "--wireframe"}) {
+       {"--size 200x150 ", "--shader flat ", "--cull back ", "--raster scanline", "--wireframe"}) {
     EXPECT_NE(moved.find(expected), std::string::npos) << expected << " not in: " << moved;
   }
   expect_window_shows(render(moved, "moved"), "viewer_moved");

@@ -9,9 +9,11 @@ namespace softrast::cli {
 namespace {
 
 void define_output_flags(CLI::App& app, RawArgs& a) {
-  app.add_option("MODEL", a.model,
-                 "Wavefront OBJ file (positions in world space); without it, "
-                 "the built-in demo scene");
+  app.add_option("MODEL", a.models,
+                 "Model files (Wavefront OBJ, with the MTL files they name) or folders of them; "
+                 "several are drawn together as one scene, each with its own materials. Without "
+                 "MODEL, the built-in demo scene")
+      ->type_name("MODEL...");
   app.add_option("-o,--out", a.output,
                  "Output image, .png or .tga (default softrast.png; with --frames, only if given)")
       ->type_name("PATH");
@@ -19,15 +21,36 @@ void define_output_flags(CLI::App& app, RawArgs& a) {
   app.add_option("--frames", a.frames,
                  "Benchmark: time N frames after 2 warm-up frames, print one JSON line")
       ->type_name("N");
-  app.add_flag("-q,--quiet", a.quiet, "No progress messages on stderr");
+  app.add_flag("-q,--quiet", a.quiet, "No progress messages or warnings on stderr");
 }
 
 void define_camera_flags(CLI::App& app, RawArgs& a) {
-  app.add_option("--eye", a.eye, "Camera position (default: frame the model from +z)")
+  app.add_option("--eye", a.eye,
+                 "Camera position (default: placed by --view, --azimuth, --elevation and --zoom)")
       ->type_name("X,Y,Z");
   app.add_option("--target", a.target, "Point looked at (default: the model's centre)")
       ->type_name("X,Y,Z");
-  app.add_option("--up", a.up, "Up direction (default 0,1,0)")->type_name("X,Y,Z");
+  app.add_option("--up", a.up, "Camera up direction (default: the model's up axis)")
+      ->type_name("X,Y,Z");
+  app.add_option("--up-axis", a.up_axis,
+                 "The model's up direction: +x, -x, +y, -y, +z or -z (default +y; +z for models "
+                 "made Z-up)")
+      ->type_name("AXIS");
+  app.add_option("--view", a.view,
+                 "Side the model is seen from: front, back, left, right, top, bottom or iso "
+                 "(default front, or from 45 degrees above a model flat along its up axis)")
+      ->type_name("NAME");
+  app.add_option("--azimuth", a.azimuth,
+                 "Camera angle around the up axis, from the front towards the right (default: "
+                 "from --view)")
+      ->type_name("DEG");
+  app.add_option("--elevation", a.elevation,
+                 "Camera angle above the horizon, -90 to 90 (default: from --view)")
+      ->type_name("DEG");
+  app.add_option("--zoom", a.zoom,
+                 "Size of the framed model: 1 fills 90% of the image's width or height, "
+                 "whichever limits it, 2 twice that (default 1)")
+      ->type_name("F");
   app.add_option("--fov", a.fov, "Vertical field of view in degrees, gluPerspective (default 45)")
       ->type_name("DEG");
   app.add_option("--ortho", a.ortho, "Orthographic box (glOrtho) instead of a perspective")
@@ -40,18 +63,39 @@ void define_camera_flags(CLI::App& app, RawArgs& a) {
 
 void define_shading_flags(CLI::App& app, RawArgs& a) {
   app.add_option("--shader", a.shader,
-                 "flat, gouraud, texture, phong, normals, depth or wireframe (default phong)")
+                 "flat, gouraud, texture, phong, normals, depth or wireframe (default phong); "
+                 "depth is the depth view (grey by distance), not the depth test (--depth)")
       ->type_name("NAME");
-  app.add_flag("--wireframe", a.wireframe, "Draw the triangle edges over any shader");
-  app.add_option("--texture", a.texture, "PNG/TGA/JPG texture for texture and phong")
+  app.add_flag("--wireframe", a.wireframe, "Draw the visible triangle edges over any shader");
+  app.add_option("--edge-color", a.edge_color,
+                 "Colour of the --wireframe edges (default 0.05,0.05,0.05)")
+      ->type_name("R,G,B");
+  app.add_option("--texture", a.texture,
+                 "PNG/TGA/JPG texture for texture and phong; overrides the maps (map_Kd) of the "
+                 "model's MTL materials")
       ->type_name("PATH");
-  app.add_option("--color", a.color, "Albedo for flat, gouraud and phong (default 0.9,0.6,0.3)")
+  app.add_option("--color", a.color,
+                 "Albedo for flat, gouraud and phong where the model has no material "
+                 "(default 0.9,0.6,0.3)")
       ->type_name("R,G,B");
   app.add_option("--light", a.light,
                  "Direction towards the light, fixed in world space (default: a headlight, "
                  "0.3,0.5,0.8 in the camera's frame, so any view is lit from its upper left)")
       ->type_name("X,Y,Z");
-  app.add_option("--alpha", a.alpha, "Output alpha in [0, 1] (default 1)")->type_name("A");
+  app.add_option("--ambient", a.ambient,
+                 "Ambient light of gouraud and phong, 0 to 1 (default 0.15)")
+      ->type_name("A");
+  app.add_option("--light-intensity", a.light_intensity,
+                 "Strength of the diffuse and specular light, 0 to 100 (default 1)")
+      ->type_name("I");
+  app.add_option("--alpha", a.alpha,
+                 "The model's opacity, 0 to 1, written to the image's alpha channel; with --blend "
+                 "alpha what is behind shows through (default 1). See --background for the "
+                 "background's")
+      ->type_name("A");
+  app.add_option("--background", a.background,
+                 "Background colour, alpha 0 for a transparent PNG (default 0.1,0.1,0.1,1)")
+      ->type_name("R,G,B[,A]");
   app.add_option("--filter", a.filter,
                  "Texture filter: nearest, bilinear or trilinear (mipmapped) (default bilinear)")
       ->type_name("MODE");
@@ -61,13 +105,16 @@ void define_shading_flags(CLI::App& app, RawArgs& a) {
 }
 
 void define_state_flags(CLI::App& app, RawArgs& a) {
-  app.add_option("--cull", a.cull, "Face culling: back, front or none (default back)")
+  app.add_option("--cull", a.cull,
+                 "Face culling: none, back or front (default none: both faces drawn, a back face "
+                 "lit as its front; back skips back faces, as the benchmark scenes do)")
       ->type_name("MODE");
   app.add_option("--front-face", a.front_face, "Front-facing winding: ccw or cw (default ccw)")
       ->type_name("MODE");
   app.add_option("--depth", a.depth,
-                 "Depth test: less, lequal, equal, greater, gequal, notequal, always, never or "
-                 "off (default less)")
+                 "Depth test, which surface hides which: less, lequal, equal, greater, gequal, "
+                 "notequal, always, never or off (default less); not the depth view (--shader "
+                 "depth)")
       ->type_name("FUNC");
   app.add_option("--blend", a.blend, "Blending: opaque, alpha or add (default opaque)")
       ->type_name("MODE");

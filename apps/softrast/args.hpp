@@ -4,23 +4,30 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 namespace softrast::cli {
 
 struct RawArgs {
-  std::optional<std::string> model;  // none: the built-in demo scene
+  std::vector<std::string> models;  // files and folders; none: the built-in demo scene
   std::optional<std::string> output;
   std::optional<std::string> size;
   std::optional<std::string> eye, target, up, ortho;
   std::optional<float> fov, near_plane, far_plane;
+  std::string up_axis = "+y";
+  std::optional<std::string> view;
+  std::optional<float> azimuth, elevation, zoom;
   std::string shader = "phong";
   bool wireframe = false;
   std::optional<std::string> texture;
   std::optional<std::string> color;
   std::optional<std::string> light;
-  std::string cull = "back";
+  std::optional<float> ambient, light_intensity;
+  std::optional<std::string> edge_color;
+  std::optional<std::string> background;
+  std::string cull = "none";
   std::string front_face = "ccw";
   std::string depth = "less";
   std::string blend = "opaque";

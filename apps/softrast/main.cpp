@@ -3,9 +3,11 @@
 // "softrast: error: ..." (here, and in batch, info and sequence through report.hpp). SIGINT and
 // SIGTERM still end it as signals, after removing any temporary image file.
 //
-//   softrast [render] [MODEL] [-o out.png] [flags]     see `softrast --help`
-//   softrast batch JOBS.jsonl [--shard K/N]             see `softrast batch --help`
+//   softrast [render] [MODEL...] [-o out.png] [flags]     see `softrast --help`
+//   softrast batch JOBS.jsonl [--shard K/N]               see `softrast batch --help`
 //   softrast info MODEL... [--json]
+//   softrast view [MODEL...]
+//   softrast help [COMMAND]
 
 #include <signal.h>
 
@@ -13,6 +15,7 @@
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +28,7 @@
 #include "sequence.hpp"
 #include "setup.hpp"
 #include "softrast/image.hpp"
+#include "values.hpp"
 #include "view.hpp"
 
 namespace {
@@ -62,15 +66,22 @@ void describe(CLI::App& app, CLI::App& render) {
   app.require_subcommand(1, 1);
   render.set_version_flag("--version", kVersion);
   render.footer(
-      "Without MODEL, renders the built-in demo scene with its camera. Without --eye, a model is "
-      "framed automatically from +z (from 45 degrees above when it is flat in y). `softrast` "
-      "without a subcommand is `softrast render`. `softrast view [MODEL...]` opens the live "
-      "viewer (softrast view --help).\n\n"
+      "Without MODEL, renders the built-in demo scene with its camera. Without --eye, the models "
+      "are framed to fill 90% of the image's width or height, seen from --view (default front) "
+      "relative to --up-axis. `softrast` without a subcommand is `softrast render`; `softrast "
+      "help [COMMAND]` prints this help. `softrast view [MODEL...]` opens the live viewer "
+      "(softrast view --help).\n\n"
+      "Materials: the MTL files an OBJ names (mtllib) are read, with each material's colour (Kd) "
+      "and texture (map_Kd); --texture overrides their maps.\n"
+      "Depth: --depth sets the depth test (which surface hides which); --shader depth is the "
+      "depth view (grey by distance, white nearest, black farthest).\n\n"
       "Examples:\n"
       "  softrast render -o demo.png\n"
       "  softrast render model.obj --size 1920x1080 --shader gouraud --wireframe\n"
+      "  softrast render body.obj head.obj --view iso -o character.png\n"
+      "  softrast render parts/ --up-axis +z --view left --background 1,1,1,0 -o thumb.png\n"
       "  softrast render model.obj --eye 0,1,3 --target 0,0,0 --fov 45 --near 0.1 --far 100\n"
-      "  softrast render scene.obj --frames 10    # one JSON line of timings\n"
+      "  softrast render scene.obj --cull back --frames 10    # one JSON line of timings\n"
       "  softrast render model.obj --turntable 36 -o frames/   # frames/frame_000.png ...\n\n"
       "Other commands (each with --help):\n"
       "  softrast info MODEL... [--json]           # triangles, bounds, materials, maps found\n"
@@ -92,6 +103,43 @@ void install_signal_handlers() {
   sigemptyset(&action.sa_mask);
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+}
+
+// `softrast help [COMMAND]`: the help of COMMAND (default render, as `softrast --help`).
+int help_command(CLI::App& app, const std::vector<std::string>& words) {
+  std::string name = words.size() > 1 ? words[1] : "render";
+  std::vector<CLI::App*> commands = app.get_subcommands([](CLI::App*) { return true; });
+  std::string names;
+  for (CLI::App* command : commands) {
+    if (command->get_name() == name && words.size() <= 2) {
+      std::fputs(command->help(app.get_name()).c_str(), stdout);
+      return 0;
+    }
+    names += (names.empty() ? "" : ", ") + command->get_name();
+  }
+  report_error(words.size() > 2 ? "help: expected at most one command (" + names + ")"
+                                : "help: unknown command '" + name + "' (commands: " + names + ")");
+  return kExitUsage;
+}
+
+// The message for an argument CLI11 did not expect: an unknown flag gets the closest known one
+// ("did you mean --shader?") when it is a likely typo.
+std::string unexpected_message(const CLI::App& command, const CLI::ParseError& e) {
+  std::vector<std::string> extras = command.remaining();
+  auto flag = std::find_if(extras.begin(), extras.end(),
+                           [](const std::string& a) { return a.size() > 1 && a[0] == '-'; });
+  if (flag == extras.end()) return std::string(e.what()) + " (see softrast --help)";
+  std::string word = flag->substr(0, flag->find('='));
+  std::vector<std::string> known;
+  for (const CLI::Option* option : command.get_options()) {
+    for (const std::string& n : option->get_lnames()) known.push_back("--" + n);
+    for (const std::string& n : option->get_snames()) known.push_back("-" + n);
+  }
+  std::string message = "unknown flag '" + word + "'";
+  if (std::optional<std::string> close = closest_word(word, known)) {
+    message += "; did you mean " + *close + "?";
+  }
+  return message + " (see softrast --help)";
 }
 
 // Parses and checks everything, then loads, renders and writes.
@@ -130,9 +178,14 @@ int run(int argc, char** argv) {
   CLI::App* info = app.add_subcommand("info", "Describe models: triangles, bounds, materials");
   InfoArgs info_args;
   define_info_flags(*info, info_args);
+  std::vector<std::string> words(argv + 1, argv + argc);
+  if (!words.empty() && words.front() == "help") return help_command(app, words);
   try {
     std::vector<std::string> args = command_arguments(argc, argv);
     app.parse(args);
+  } catch (const CLI::ExtrasError& e) {
+    report_error(unexpected_message(*render, e));
+    return kExitUsage;
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     report_error(std::string(e.what()) + " (see softrast --help)");

@@ -34,10 +34,11 @@ std::string size_text(const Job& job) {
   return std::to_string(job.framebuffer.width()) + "x" + std::to_string(job.framebuffer.height());
 }
 
-// One frame as SCENES.md defines it: clear colour and depth, draw everything. Milliseconds.
+// One frame as SCENES.md defines it: clear colour (--background) and depth, draw everything.
+// Milliseconds.
 double render_frame(Job& job) {
   auto start = std::chrono::steady_clock::now();
-  job.framebuffer.clear({0.1f, 0.1f, 0.1f, 1.0f}, 1.0f, job.options.state.threads);
+  job.framebuffer.clear(job.background, 1.0f, job.options.state.threads);
   render_mesh(job.framebuffer, job.scene.mesh, job.scene.camera, job.options);
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
@@ -122,6 +123,13 @@ Status write_image(const Job& job) {
 }  // namespace
 
 Status run_job(Job& job) {
+  // What the render works around (a texture that cannot show, a file a model names that is
+  // missing), before the progress lines; --quiet silences these too.
+  if (!job.quiet) {
+    for (const std::string& warning : job.scene.warnings) {
+      std::fprintf(stderr, "softrast: warning: %s\n", warning.c_str());
+    }
+  }
   progress(job, "loaded " + job.scene.source + ": " +
                     std::to_string(job.scene.mesh.triangle_count()) + " triangles in " +
                     format("%.1f", job.scene.load_ms) + " ms");

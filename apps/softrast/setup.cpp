@@ -20,6 +20,7 @@
 #include <utility>
 
 #include "debug_flag.hpp"
+#include "scene_files.hpp"
 #include "softrast/image.hpp"
 #include "softrast/texture.hpp"
 #include "values.hpp"
@@ -105,6 +106,14 @@ std::string lowercase_extension(const std::string& path) {
 }
 
 constexpr int kMaxThreads = 1024;
+constexpr float kMaxLightIntensity = 100.0f;
+
+const std::array<Named<glm::vec3>, 6> kUpAxes = {{{"+x", {1.0f, 0.0f, 0.0f}},
+                                                  {"-x", {-1.0f, 0.0f, 0.0f}},
+                                                  {"+y", {0.0f, 1.0f, 0.0f}},
+                                                  {"-y", {0.0f, -1.0f, 0.0f}},
+                                                  {"+z", {0.0f, 0.0f, 1.0f}},
+                                                  {"-z", {0.0f, 0.0f, -1.0f}}}};
 
 void interpret_state(const RawArgs& a, RenderState& state, FirstError& e) {
   e.take(lookup<CullMode>("--cull", kCullModes, a.cull), state.cull);
@@ -125,15 +134,28 @@ void interpret_shading(const RawArgs& a, RenderOptions& options, FirstError& e) 
   e.take(shader_named(a.shader), options.shader);
   options.wireframe_overlay = a.wireframe;
   if (a.color) {
-    e.take(parse_vec3("--color", *a.color), options.color);
-    glm::vec3 c = options.color;
-    e.fail_if(!in_unit_range(c.r) || !in_unit_range(c.g) || !in_unit_range(c.b),
-              "--color: every channel must be in [0, 1], got '" + *a.color + "'");
+    glm::vec4 color(0.0f);
+    e.take(parse_color("--color", *a.color, false), color);
+    options.color = glm::vec3(color);
   }
   if (a.light) {
     e.take(parse_vec3("--light", *a.light), options.light_direction);
     e.fail_if(!(glm::length(options.light_direction) > 1.0e-6f),
               "--light: the direction must not be zero, got '" + *a.light + "'");
+  }
+  if (a.ambient) {
+    e.fail_if(!in_unit_range(*a.ambient), "--ambient: must be in [0, 1]");
+    options.ambient = *a.ambient;
+  }
+  if (a.light_intensity) {
+    e.fail_if(!(*a.light_intensity >= 0.0f && *a.light_intensity <= kMaxLightIntensity),
+              "--light-intensity: must be in [0, 100]");
+    options.light_intensity = *a.light_intensity;
+  }
+  if (a.edge_color) {
+    glm::vec4 edge(0.0f);
+    e.take(parse_color("--edge-color", *a.edge_color, false), edge);
+    options.wire_color = glm::vec3(edge);
   }
   e.fail_if(!in_unit_range(a.alpha), "--alpha: must be in [0, 1]");
   options.alpha = a.alpha;
@@ -162,6 +184,34 @@ void check_camera_flags(const CameraFlags& c, FirstError& e) {
   }
 }
 
+// --up-axis, and the flags that place the camera instead of --eye.
+void interpret_placement(const RawArgs& a, CameraFlags& c, FirstError& e) {
+  e.take(lookup<glm::vec3>("--up-axis", kUpAxes, a.up_axis), c.up_axis);
+  if (a.view) {
+    std::optional<Orientation> o = view_named(*a.view);
+    e.fail_if(!o, "--view: unknown view '" + *a.view + "' (expected " + view_names() + ")");
+    if (o) c.azimuth = o->azimuth, c.elevation = o->elevation;
+  }
+  if (a.azimuth) {
+    e.fail_if(!std::isfinite(*a.azimuth), "--azimuth: must be a finite number of degrees");
+    c.azimuth = a.azimuth;
+  }
+  if (a.elevation) {
+    e.fail_if(!(*a.elevation >= -90.0f && *a.elevation <= 90.0f),
+              "--elevation: must be in [-90, 90] degrees");
+    c.elevation = a.elevation;
+  }
+  if (a.zoom) {
+    e.fail_if(!(*a.zoom > 0.0f && *a.zoom <= 1000.0f), "--zoom: must be in (0, 1000]");
+    c.zoom = *a.zoom;
+    e.fail_if(a.ortho.has_value(), "--zoom: not with --ortho (its box sets the size)");
+  }
+  bool placed = a.view || a.azimuth || a.elevation || a.zoom;
+  e.fail_if(a.eye && placed,
+            "--eye places the camera itself; it cannot be combined with --view, --azimuth, "
+            "--elevation or --zoom");
+}
+
 void interpret_camera(const RawArgs& a, CameraFlags& c, FirstError& e) {
   if (a.eye) e.take(parse_vec3("--eye", *a.eye), c.eye);
   if (a.target) e.take(parse_vec3("--target", *a.target), c.target);
@@ -171,6 +221,7 @@ void interpret_camera(const RawArgs& a, CameraFlags& c, FirstError& e) {
   c.near_plane = a.near_plane;
   c.far_plane = a.far_plane;
   check_camera_flags(c, e);
+  interpret_placement(a, c, e);
 }
 
 void interpret_output(const RawArgs& a, JobSpec& spec, FirstError& e) {
@@ -185,6 +236,7 @@ void interpret_output(const RawArgs& a, JobSpec& spec, FirstError& e) {
               "--frames: must be in 1.." + std::to_string(kMaxFrames));
     spec.frames = *a.frames;
   }
+  if (a.background) e.take(parse_color("--background", *a.background, true), spec.background);
   spec.output = a.output;
   if (!spec.output && spec.frames == 0) spec.output = "softrast.png";
   if (spec.output) {
@@ -221,26 +273,52 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
-// A model file framed automatically, or the demo scene with its own camera; the flags override
-// either.
+// The scene's name for the benchmark line: each model file's name without extension (a folder's
+// name), joined by "+"; "demo" without models.
+std::string scene_name(const std::vector<std::string>& args) {
+  if (args.empty()) return "demo";
+  std::string name;
+  for (const std::string& arg : args) {
+    fs::path path = fs::path(arg).lexically_normal();
+    if (path.filename().empty()) path = path.parent_path();  // "folder/"
+    name += (name.empty() ? "" : "+") +
+            (path.has_extension() ? path.stem().string() : path.filename().string());
+  }
+  return name;
+}
+
+std::string joined(const std::vector<std::string>& args) {
+  std::string text;
+  for (const std::string& a : args) text += (text.empty() ? "" : " ") + a;
+  return text;
+}
+
+// The model files framed automatically as one scene, or the demo scene with its own camera; the
+// flags override either.
 Result<Scene> load_scene(const JobSpec& spec, const Loaders& loaders) {
   auto start = std::chrono::steady_clock::now();
   Scene scene;
-  if (!spec.model) {
+  if (spec.models.empty()) {
     DemoScene demo = make_demo_scene();
     scene.mesh = std::move(demo.mesh);
     scene.camera = demo.camera;
     apply_flags(scene.camera, spec.camera);
   } else {
-    Result<Mesh> mesh = loaders.model ? loaders.model(*spec.model) : load_obj(*spec.model);
-    if (!mesh) return mesh.status();
-    scene.mesh = std::move(*mesh);
+    Result<std::vector<std::string>> paths = expand_model_paths(spec.models);
+    if (!paths) return paths.status();
+    Result<LoadedModels> loaded = load_models(*paths, loaders.model);
+    if (!loaded) return loaded.status();
+    scene.mesh = std::move(loaded->mesh);
+    scene.warnings = std::move(loaded->warnings);
+    std::vector<std::string> more =
+        texture_warnings(loaded->parts, spec.options, spec.texture.has_value());
+    scene.warnings.insert(scene.warnings.end(), more.begin(), more.end());
     float aspect = float(spec.width) / float(spec.height);
-    scene.camera = frame_model(bounds_of(scene.mesh), spec.camera, aspect);
+    scene.camera = frame_model(scene.mesh, spec.camera, aspect);
   }
   scene.load_ms = milliseconds_since(start);
-  scene.name = spec.model ? fs::path(*spec.model).stem().string() : "demo";
-  scene.source = spec.model ? *spec.model : "demo scene";
+  scene.name = scene_name(spec.models);
+  scene.source = spec.models.empty() ? "demo scene" : joined(spec.models);
   if (Status s = scene.camera.validate(); !s.ok()) return s;
   return scene;
 }
@@ -255,9 +333,15 @@ Result<JobSpec> interpret(const RawArgs& args) {
   interpret_shading(args, spec.options, e);
   interpret_state(args, spec.options.state, e);
   if (!e.status().ok()) return e.status();
-  spec.model = args.model;
+  spec.models = args.models;
   spec.texture = args.texture;
   spec.headlight = !args.light;
+  if (args.models.empty()) {
+    e.fail_if(args.up_axis != "+y" || args.view || args.azimuth || args.elevation || args.zoom,
+              "--up-axis, --view, --azimuth, --elevation and --zoom frame a model; the demo "
+              "scene has its own camera");
+    if (!e.status().ok()) return e.status();
+  }
   spec.quiet = args.quiet;
   return spec;
 }
@@ -285,6 +369,7 @@ Result<Job> prepare(const JobSpec& spec, const Loaders& loaders) {
   }
   Job job(std::move(*scene), std::move(*framebuffer));
   job.options = std::move(options);
+  job.background = spec.background;
   job.output = spec.output;
   job.frames = spec.frames;
   job.quiet = spec.quiet;

@@ -9,6 +9,9 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
+
+#include <glm/vec4.hpp>
 
 #include "args.hpp"
 #include "framing.hpp"
@@ -23,7 +26,7 @@ namespace softrast::cli {
 
 // Every flag checked and typed; files not yet opened.
 struct JobSpec {
-  std::optional<std::string> model;   // none: the demo scene
+  std::vector<std::string> models;    // files and folders; none: the demo scene
   std::optional<std::string> output;  // none: no image (benchmark without -o)
   int width = 800;
   int height = 600;
@@ -33,6 +36,7 @@ struct JobSpec {
   // No --light: the light follows the camera (options.light_direction is then taken in the
   // camera's frame: x right, y up, z towards the viewer).
   bool headlight = true;
+  glm::vec4 background{0.1f, 0.1f, 0.1f, 1.0f};
   int frames = 0;  // 0: one untimed render
   bool quiet = false;
 };
@@ -40,10 +44,12 @@ struct JobSpec {
 // The mesh and the camera to see it with.
 struct Scene {
   std::string name;    // the model's file name without extension, or "demo"
-  std::string source;  // for messages: the model path or "demo scene"
-  Mesh mesh;
-  Camera camera;  // validated
+  std::string source;  // for messages: the model path(s) or "demo scene"
+  Mesh mesh;           // every model file merged, each with its own materials
+  Camera camera;       // validated
   double load_ms = 0.0;
+  // "softrast: warning: " lines to print before rendering (the message part).
+  std::vector<std::string> warnings;
 };
 
 // What run_job() needs: everything loaded and validated.
@@ -53,6 +59,7 @@ struct Job {
   Scene scene;
   Framebuffer framebuffer;
   RenderOptions options;
+  glm::vec4 background{0.1f, 0.1f, 0.1f, 1.0f};
   std::optional<std::string> output;
   int frames = 0;
   bool quiet = false;

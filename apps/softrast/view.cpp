@@ -103,7 +103,8 @@ void define_view_flags(CLI::App& app, ViewArgs& a) {
                  "flat, gouraud, texture, phong, normals, depth or wireframe (default phong)")
       ->type_name("NAME");
   app.add_flag("--wireframe", r.wireframe, "Start with the wireframe overlay on");
-  app.add_option("--cull", r.cull, "Face culling: back, front or none (default back)")
+  app.add_option("--cull", r.cull,
+                 "Face culling: back, front or none (default none: both faces, lit on both sides)")
       ->type_name("MODE");
   app.add_option("--raster", r.raster, "Rasterizer: edge (tiles) or scanline (default edge)")
       ->type_name("ALGO");

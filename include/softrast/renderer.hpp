@@ -25,7 +25,8 @@ enum class ShaderKind {
   kTexture,    // the texture at the interpolated uv
   kPhong,      // Blinn-Phong per pixel, albedo from the texture when there is one
   kNormals,    // debug: the normal as colour, n * 0.5 + 0.5
-  kDepth,      // debug: view depth as grey on a log scale, white at near, black at far
+  kDepth,      // debug: view depth as grey on a log scale, white at the nearest visible
+               // pixel, black at the farthest (the ramp spans the depth range in the image)
   kWireframe,  // triangle edges in the albedo colour, after culling
 };
 std::optional<ShaderKind> parse_shader_kind(std::string_view name);
@@ -41,6 +42,13 @@ struct RenderOptions {
   std::shared_ptr<const Texture> texture;
   Sampler sampler;
   glm::vec3 light_direction{0.3f, 0.5f, 0.8f};  // towards the light, world space; normalised
+  // The lit shaders (gouraud, phong) shade albedo * (ambient + 0.85 * light_intensity * n.l)
+  // plus, for phong, 0.4 * light_intensity * the Blinn-Phong highlight. SCENES.md: 0.15 and 1.
+  float ambient = 0.15f;
+  float light_intensity = 1.0f;
+  // Back-facing triangles (drawn when state.cull is not kBack) are lit with their normal
+  // flipped, so an open or single-sided surface looks the same from both sides.
+  bool two_sided_lighting = true;
   // Draws the culled triangle edges over the shaded mesh as well (hidden edges stay hidden).
   bool wireframe_overlay = false;
   glm::vec3 wire_color{0.05f, 0.05f, 0.05f};

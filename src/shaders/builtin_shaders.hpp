@@ -20,6 +20,19 @@ inline constexpr float kDiffuse = 0.85f;
 inline constexpr float kSpecular = 0.4f;
 inline constexpr float kShininess = 32.0f;
 
+// The light of the lit shaders: Lambert diffuse plus (phong) Blinn-Phong specular, with
+// ambient + diffuse_scale * max(n.l, 0) as the diffuse factor. SCENES.md's values by default;
+// --ambient and --light-intensity change them (diffuse and specular scale with the intensity).
+struct Lighting {
+  glm::vec3 light{0.0f, 0.0f, 1.0f};  // towards the light, normalised
+  float ambient = kAmbient;
+  float diffuse = kDiffuse;
+  float specular = kSpecular;
+  // Back-facing primitives are lit with their normal flipped (two-sided lighting), so a
+  // single-sided surface seen from behind looks as it does from the front.
+  bool two_sided = false;
+};
+
 // Inputs shared by the built-in shaders.
 struct MeshInputs {
   const Mesh* mesh = nullptr;
@@ -47,21 +60,33 @@ struct FlatShader {
   }
 };
 
+// One-sided: the colour lit by the vertex normal, 3 varyings. Two-sided: the colours for both
+// faces (by n and by -n), 6 varyings, the fragment picks by the primitive's facing.
+template <bool kTwoSided>
 struct GouraudShader {
-  static constexpr int kVaryings = 3;
+  static constexpr int kVaryings = kTwoSided ? 6 : 3;
   MeshInputs in;
   glm::vec3 albedo;
-  glm::vec3 light;  // normalised
+  Lighting lighting;
   float alpha = 1.0f;
+  glm::vec3 lit(const glm::vec3& n) const {
+    float d = std::max(glm::dot(n, lighting.light), 0.0f);
+    return albedo * (lighting.ambient + lighting.diffuse * d);
+  }
   glm::vec4 vertex(uint32_t i, float* v) const {
-    float d = std::max(glm::dot(glm::normalize(in.mesh->normals[i]), light), 0.0f);
-    glm::vec3 c = albedo * (kAmbient + kDiffuse * d);
+    glm::vec3 n = glm::normalize(in.mesh->normals[i]);
+    glm::vec3 c = lit(n);
     v[0] = c.r, v[1] = c.g, v[2] = c.b;
+    if constexpr (kTwoSided) {
+      glm::vec3 back = lit(-n);
+      v[3] = back.r, v[4] = back.g, v[5] = back.b;
+    }
     return in.clip(i);
   }
   template <int N>
   void shade(Fragments<N>& f) const {
-    f.color = {f.varying(0), f.varying(1), f.varying(2), alpha};
+    int first = kTwoSided && !f.front_facing ? 3 : 0;
+    f.color = {f.varying(first), f.varying(first + 1), f.varying(first + 2), alpha};
   }
 };
 
@@ -88,7 +113,7 @@ struct PhongShader {
   glm::vec3 albedo;
   const Texture* texture = nullptr;  // albedo from here when set
   Sampler sampler;
-  glm::vec3 light;
+  Lighting lighting;
   glm::vec3 eye;
   float alpha = 1.0f;
   glm::vec4 vertex(uint32_t i, float* v) const {
@@ -103,15 +128,16 @@ struct PhongShader {
   void shade(Fragments<N>& f) const {
     using F = simd::Float<N>;
     simd::Vec3<N> n = simd::normalize(f.vec3(3));
+    if (lighting.two_sided && !f.front_facing) n = n * F(-1.0f);
     simd::Vec3<N> view = simd::normalize(simd::splat3<N>(eye) - f.vec3(0));
-    simd::Vec3<N> l = simd::splat3<N>(light);
+    simd::Vec3<N> l = simd::splat3<N>(lighting.light);
     simd::Vec3<N> h = simd::normalize(l + view);
     F d = simd::max(simd::dot(n, l), F(0.0f));
     F s = simd::select(d > F(0.0f), pow_shininess(simd::max(simd::dot(n, h), F(0.0f))), F(0.0f));
     simd::Vec4<N> base{F(albedo.r), F(albedo.g), F(albedo.b), F(1.0f)};
     if (texture) base = sample_with_derivatives(*texture, sampler, f, 6);
-    F lit = F(kAmbient) + F(kDiffuse) * d;
-    F spec = F(kSpecular) * s;
+    F lit = F(lighting.ambient) + F(lighting.diffuse) * d;
+    F spec = F(lighting.specular) * s;
     f.color = {base.x * lit + spec, base.y * lit + spec, base.z * lit + spec, base.w * alpha};
   }
   // x^32 by five squarings (kShininess is 32).
@@ -139,22 +165,35 @@ struct NormalsShader {
   }
 };
 
-// Grey = 1 - log(depth / near) / log(far / near) of the view depth: white at the near plane,
-// black at the far plane, equal steps for equal distance ratios (a linear ramp would leave most
-// scenes a uniform white, as window depth does).
+// Grey = 1 - (g(depth) - g(nearest)) / (g(farthest) - g(nearest)) of the view depth, with
+// g = log when the range is positive (equal steps for equal distance ratios; a linear ramp of
+// window depth would leave most scenes a uniform white) and g = depth otherwise (orthographic
+// views that reach behind the eye): white at `nearest`, black at `farthest`. The renderer sets
+// the two to the depth range visible in the image, so the whole ramp is used.
 struct DepthShader {
   static constexpr int kVaryings = 1;
   MeshInputs in;
   glm::mat4 view{1.0f};
-  float near_plane = 0.1f;
-  float log_range = 1.0f;  // log(far / near)
+  bool logarithmic = true;
+  float g_nearest = 0.0f;
+  float g_scale = 1.0f;   // 1 / (g(farthest) - g(nearest))
+  float floor = 1.0e-6f;  // the smallest depth put through the log
+
+  DepthShader(const MeshInputs& inputs, const glm::mat4& view_matrix, float nearest, float farthest)
+      : in(inputs), view(view_matrix), logarithmic(nearest > 0.0f) {
+    if (logarithmic) floor = nearest * 0.5f;
+    float g_far = g(farthest);
+    g_nearest = g(nearest);
+    g_scale = g_far > g_nearest ? 1.0f / (g_far - g_nearest) : 0.0f;
+  }
+  float g(float depth) const { return logarithmic ? std::log(std::max(depth, floor)) : depth; }
   glm::vec4 vertex(uint32_t i, float* v) const {
     v[0] = -(view * glm::vec4(in.mesh->positions[i], 1.0f)).z;
     return in.clip(i);
   }
   bool fragment(FragmentInput& f, glm::vec4& out) const {
-    float g = 1.0f - std::log(std::max(f.varyings[0], near_plane) / near_plane) / log_range;
-    out = glm::vec4(glm::vec3(std::clamp(g, 0.0f, 1.0f)), 1.0f);
+    float grey = 1.0f - (g(f.varyings[0]) - g_nearest) * g_scale;
+    out = glm::vec4(glm::vec3(std::clamp(grey, 0.0f, 1.0f)), 1.0f);
     return true;
   }
 };

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <span>
 #include <string_view>
+#include <vector>
 
 #include "debug/debug_render.hpp"
 #include "shaders/builtin_shaders.hpp"
@@ -38,14 +39,31 @@ Surface surface_of(const Mesh& mesh, int material, const RenderOptions& opt) {
   return s;
 }
 
+// The view depths the depth view's grey ramp spans.
+struct DepthRange {
+  float nearest, farthest;
+};
+
+detail::Lighting lighting_of(const RenderOptions& opt) {
+  detail::Lighting l;
+  l.light = glm::normalize(opt.light_direction);
+  l.ambient = opt.ambient;
+  l.diffuse = detail::kDiffuse * opt.light_intensity;
+  l.specular = detail::kSpecular * opt.light_intensity;
+  l.two_sided = opt.two_sided_lighting;
+  return l;
+}
+
 // Draws one run of indices with the chosen built-in shader.
 void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const Camera& camera,
               const glm::mat4& mvp, std::span<const uint32_t> indices, const Surface& surf,
-              const RenderOptions& opt, ShaderKind kind) {
+              const RenderOptions& opt, ShaderKind kind, DepthRange depth) {
   using namespace detail;
   MeshInputs in{&mesh, mvp};
   uint32_t n = uint32_t(mesh.positions.size());
-  glm::vec3 light = glm::normalize(opt.light_direction);
+  Lighting lighting = lighting_of(opt);
+  // Two-sided Gouraud interpolates a second colour; only worth it when back faces are drawn.
+  bool two_sided = lighting.two_sided && state.cull != CullMode::kBack;
   static const Texture kWhite;  // samples as opaque white
   switch (kind) {
     case ShaderKind::kFlat:
@@ -53,7 +71,12 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
     case ShaderKind::kWireframe:  // the overlay passes the wire colour as the surface albedo
       return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, 1.0f)}, indices, n);
     case ShaderKind::kGouraud:
-      return draw(fb, state, GouraudShader{in, surf.albedo, light, opt.alpha}, indices, n);
+      if (two_sided) {
+        return draw(fb, state, GouraudShader<true>{in, surf.albedo, lighting, opt.alpha}, indices,
+                    n);
+      }
+      return draw(fb, state, GouraudShader<false>{in, surf.albedo, lighting, opt.alpha}, indices,
+                  n);
     case ShaderKind::kTexture: {
       const Texture* t = surf.texture ? surf.texture : &kWhite;
       return draw(fb, state, TextureShader{in, t, opt.sampler, opt.alpha}, indices, n);
@@ -61,16 +84,52 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
     case ShaderKind::kPhong:
       return draw(
           fb, state,
-          PhongShader{in, surf.albedo, surf.texture, opt.sampler, light, camera.eye, opt.alpha},
+          PhongShader{in, surf.albedo, surf.texture, opt.sampler, lighting, camera.eye, opt.alpha},
           indices, n);
     case ShaderKind::kNormals:
       return draw(fb, state, NormalsShader{in}, indices, n);
-    case ShaderKind::kDepth: {
-      float near_plane = std::max(camera.near_plane, 1.0e-3f);
-      float log_range = std::log(std::max(camera.far_plane / near_plane, 1.0f + 1.0e-3f));
-      return draw(fb, state, DepthShader{in, camera.view(), near_plane, log_range}, indices, n);
+    case ShaderKind::kDepth:
+      return draw(fb, state, DepthShader(in, camera.view(), depth.nearest, depth.farthest), indices,
+                  n);
+  }
+}
+
+// The view depth (distance along the view direction) of window depth `z` in [0, 1].
+float view_depth(const Camera& camera, float z) {
+  float n = camera.near_plane, f = camera.far_plane;
+  if (camera.orthographic) return n + z * (f - n);
+  float z_ndc = 2.0f * z - 1.0f;
+  return 2.0f * n * f / ((f + n) - z_ndc * (f - n));
+}
+
+// The nearest and farthest view depth among the pixels `runs` cover with the depth test on: a
+// depth-only pass into a scratch buffer. The camera's near and far when nothing is visible.
+DepthRange visible_depth_range(int width, int height, const Mesh& mesh, const Camera& camera,
+                               const glm::mat4& mvp, std::span<const SubMesh> runs,
+                               const RenderState& state) {
+  Framebuffer scratch(width, height);
+  scratch.clear_depth(1.0f);
+  RenderState depth_only = state;
+  depth_only.depth_test = true;
+  depth_only.depth_write = true;
+  depth_only.depth_func = DepthFunc::kLess;
+  depth_only.blend = BlendMode::kOpaque;
+  detail::FlatShader shader{{&mesh, mvp}, glm::vec4(1.0f)};
+  for (const SubMesh& run : runs) {
+    std::span<const uint32_t> indices(mesh.indices.data() + run.first_index, run.index_count);
+    draw(scratch, depth_only, shader, indices, uint32_t(mesh.positions.size()));
+  }
+  float lo = 1.0f, hi = 0.0f;
+  for (int y = 0; y < height; ++y) {
+    const float* row = scratch.depth_row(y);
+    for (int x = 0; x < width; ++x) {
+      if (row[x] >= 1.0f) continue;  // the clear value: nothing drawn here
+      lo = std::min(lo, row[x]);
+      hi = std::max(hi, row[x]);
     }
   }
+  if (lo > hi) return {camera.near_plane, camera.far_plane};
+  return {view_depth(camera, lo), view_depth(camera, hi)};
 }
 
 // A mesh whose normals and uvs match its positions (the built-in shaders read all three).
@@ -113,11 +172,18 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
 
   RenderState state = options.state;
   if (options.shader == ShaderKind::kWireframe) state.wireframe = true;
+  std::erase_if(runs, [&](const SubMesh& run) {
+    return size_t(run.first_index) + run.index_count > mesh.indices.size();
+  });
+  DepthRange depth{camera.near_plane, camera.far_plane};
+  if (options.shader == ShaderKind::kDepth) {
+    depth = visible_depth_range(framebuffer.width(), framebuffer.height(), mesh, camera, mvp, runs,
+                                state);
+  }
   for (const SubMesh& run : runs) {
-    if (size_t(run.first_index) + run.index_count > mesh.indices.size()) continue;
     std::span<const uint32_t> indices(mesh.indices.data() + run.first_index, run.index_count);
     Surface surf = surface_of(mesh, run.material, options);
-    draw_run(framebuffer, state, mesh, camera, mvp, indices, surf, options, options.shader);
+    draw_run(framebuffer, state, mesh, camera, mvp, indices, surf, options, options.shader, depth);
   }
   if (options.wireframe_overlay && options.shader != ShaderKind::kWireframe) {
     RenderState wire = options.state;
@@ -133,7 +199,7 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
     wire.polygon_offset_units = -4.0f;
     std::span<const uint32_t> all(mesh.indices);
     draw_run(framebuffer, wire, mesh, camera, mvp, all, Surface{options.wire_color, nullptr},
-             options, ShaderKind::kWireframe);
+             options, ShaderKind::kWireframe, depth);
   }
 }
 

@@ -78,7 +78,7 @@ struct Options {
   glm::vec3 color{0.9f, 0.6f, 0.3f};
   glm::vec3 light{0.3f, 0.5f, 0.8f};  // towards the light, world space
   float alpha = 1.0f;
-  std::string cull = "back", front_face = "ccw", depth = "less", blend = "opaque";
+  std::string cull = "none", front_face = "ccw", depth = "less", blend = "opaque";
   int frames = 0;
   std::optional<int> threads;
   std::optional<std::string> out;
@@ -98,7 +98,8 @@ constexpr const char* kHelp =
     "  --texture PATH      PNG/TGA texture for texture and phong\n"
     "  --color R,G,B       albedo for flat, gouraud and phong (0.9,0.6,0.3)\n"
     "  --alpha A           output alpha (1)\n"
-    "  --cull MODE         back, front or none (back); --front-face ccw|cw (ccw)\n"
+    "  --cull MODE         back, front or none (none; back faces lit as front faces, as\n"
+    "                      softrast does); --front-face ccw|cw (ccw)\n"
     "  --depth FUNC        less, lequal, equal, greater, gequal, notequal, always, never, off\n"
     "  --blend MODE        opaque, alpha or add (opaque)\n"
     "  --frames N          time N frames after 2 warm-ups; one JSON line on stdout\n"
@@ -467,6 +468,7 @@ uniform vec3 u_albedo;
 uniform vec3 u_light;  // normalised, towards the light
 #if defined(GOURAUD)
 out vec3 v_color;
+out vec3 v_back_color;  // two-sided lighting: lit by the flipped normal
 #elif defined(TEXTURE)
 out vec2 v_uv;
 #elif defined(PHONG)
@@ -481,6 +483,8 @@ void main() {
 #if defined(GOURAUD)
   float d = max(dot(normalize(a_normal), u_light), 0.0);
   v_color = u_albedo * (0.15 + 0.85 * d);
+  float back = max(dot(-normalize(a_normal), u_light), 0.0);
+  v_back_color = u_albedo * (0.15 + 0.85 * back);
 #elif defined(TEXTURE)
   v_uv = a_uv;
 #elif defined(PHONG)
@@ -505,7 +509,8 @@ out vec4 o_color;
 void main() { o_color = vec4(u_albedo, u_alpha); }
 #elif defined(GOURAUD)
 in vec3 v_color;
-void main() { o_color = vec4(v_color, u_alpha); }
+in vec3 v_back_color;
+void main() { o_color = vec4(gl_FrontFacing ? v_color : v_back_color, u_alpha); }
 #elif defined(TEXTURE)
 in vec2 v_uv;
 void main() {
@@ -517,7 +522,7 @@ in vec3 v_position;
 in vec3 v_normal;
 in vec2 v_uv;
 void main() {
-  vec3 n = normalize(v_normal);
+  vec3 n = gl_FrontFacing ? normalize(v_normal) : -normalize(v_normal);  // two-sided
   vec3 v = normalize(u_eye - v_position);
   vec3 h = normalize(u_light + v);
   float d = max(dot(n, u_light), 0.0);

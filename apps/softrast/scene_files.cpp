@@ -1,0 +1,157 @@
+// apps/softrast/scene_files.cpp: several model files as one scene.
+
+#include "scene_files.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstdint>
+#include <filesystem>
+#include <string_view>
+
+namespace softrast::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The extensions a folder's model files have (compared in lower case).
+// TODO(lead, merging the io branch): add ".ply" and ".stl" here and call its load_model() (which
+// tells the formats apart by content) instead of load_obj() in load_models(); its Mesh::warnings
+// then reach Scene::warnings through take_loader_warnings(), so the io branch's own printing of
+// them in setup.cpp's load_scene() goes.
+constexpr std::array<std::string_view, 1> kModelExtensions = {".obj"};
+
+std::string lowercase(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return text;
+}
+
+bool is_model_file(const fs::directory_entry& entry) {
+  std::error_code ec;
+  if (!entry.is_regular_file(ec)) return false;
+  std::string ext = lowercase(entry.path().extension().string());
+  return std::find(kModelExtensions.begin(), kModelExtensions.end(), ext) != kModelExtensions.end();
+}
+
+std::string extension_list() {
+  std::string list;
+  for (std::string_view ext : kModelExtensions)
+    list += (list.empty() ? "" : ", ") + std::string(ext);
+  return list;
+}
+
+Result<std::vector<std::string>> folder_models(const std::string& folder) {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder, ec)) {
+    if (is_model_file(entry)) files.push_back(entry.path().string());
+  }
+  if (ec) return Status::error(folder + ": cannot list the folder: " + ec.message());
+  if (files.empty()) {
+    return Status::error(folder + ": no model files (" + extension_list() + ") in this folder");
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// The loader's warnings (missing MTL or map files), where this version of Mesh carries them.
+template <class M>
+void take_loader_warnings(const M& mesh, std::vector<std::string>& out) {
+  if constexpr (requires { mesh.warnings; }) {
+    for (const auto& w : mesh.warnings) out.push_back(std::string(w));
+  }
+}
+
+bool has_varying_uvs(const Mesh& mesh) {
+  for (const glm::vec2& uv : mesh.uvs) {
+    if (uv != mesh.uvs.front()) return true;
+  }
+  return false;
+}
+
+bool has_maps(const Mesh& mesh) {
+  return std::any_of(mesh.materials.begin(), mesh.materials.end(),
+                     [](const Material& m) { return m.diffuse_map != nullptr; });
+}
+
+}  // namespace
+
+Result<std::vector<std::string>> expand_model_paths(const std::vector<std::string>& args) {
+  std::vector<std::string> paths;
+  for (const std::string& arg : args) {
+    std::error_code ec;
+    if (!fs::is_directory(arg, ec)) {
+      paths.push_back(arg);
+      continue;
+    }
+    Result<std::vector<std::string>> files = folder_models(arg);
+    if (!files) return files.status();
+    paths.insert(paths.end(), files->begin(), files->end());
+  }
+  return paths;
+}
+
+Status append_mesh(Mesh& scene, const Mesh& part) {
+  size_t base = scene.positions.size();
+  if (base + part.positions.size() > size_t(UINT32_MAX)) {
+    return Status::error("the scene has more than 2^32 vertices");
+  }
+  uint32_t first = uint32_t(scene.indices.size());
+  int material_base = int(scene.materials.size());
+  scene.positions.insert(scene.positions.end(), part.positions.begin(), part.positions.end());
+  scene.normals.insert(scene.normals.end(), part.normals.begin(), part.normals.end());
+  scene.uvs.insert(scene.uvs.end(), part.uvs.begin(), part.uvs.end());
+  scene.materials.insert(scene.materials.end(), part.materials.begin(), part.materials.end());
+  for (uint32_t i : part.indices) scene.indices.push_back(uint32_t(base) + i);
+  if (part.submeshes.empty()) {
+    scene.submeshes.push_back({first, uint32_t(part.indices.size()), -1});
+  }
+  for (SubMesh run : part.submeshes) {
+    run.first_index += first;
+    if (run.material >= 0) run.material += material_base;
+    scene.submeshes.push_back(run);
+  }
+  return {};
+}
+
+Result<LoadedModels> load_models(const std::vector<std::string>& paths, const ModelLoader& load) {
+  LoadedModels loaded;
+  for (const std::string& path : paths) {
+    Result<Mesh> mesh = load ? load(path) : load_obj(path);
+    if (!mesh) return mesh.status();
+    take_loader_warnings(*mesh, loaded.warnings);
+    loaded.parts.push_back({path, has_varying_uvs(*mesh), has_maps(*mesh)});
+    if (paths.size() == 1) {
+      loaded.mesh = std::move(*mesh);
+    } else if (Status s = append_mesh(loaded.mesh, *mesh); !s.ok()) {
+      return s;
+    }
+  }
+  return loaded;
+}
+
+std::vector<std::string> texture_warnings(const std::vector<ModelPart>& parts,
+                                          const RenderOptions& options, bool texture_flag) {
+  std::vector<std::string> warnings;
+  bool textured_shader =
+      options.shader == ShaderKind::kTexture || options.shader == ShaderKind::kPhong;
+  if (!textured_shader) return warnings;
+  bool any_map =
+      std::any_of(parts.begin(), parts.end(), [](const ModelPart& p) { return p.has_maps; });
+  if (options.shader == ShaderKind::kTexture && !texture_flag && !any_map) {
+    warnings.push_back(
+        "--shader texture: the model has no texture (no --texture, no map_Kd in its "
+        "materials), so it is drawn white");
+  }
+  for (const ModelPart& part : parts) {
+    if ((texture_flag || part.has_maps) && !part.has_uvs) {
+      warnings.push_back(part.path +
+                         ": the model has no texture coordinates (vt), so its texture shows "
+                         "as one colour");
+    }
+  }
+  return warnings;
+}
+
+}  // namespace softrast::cli

@@ -1,0 +1,365 @@
+// tests/cli_scene_test.cpp: what `softrast render` shows of a model, checked on the images it
+// writes: two-sided lighting, the light's strength, the depth view's range, the overlay's edge
+// colour, scenes of several files, automatic framing for every view and aspect, the background.
+#ifdef SOFTRAST_CLI_PATH
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cli_util.hpp"
+#include "softrast/framebuffer.hpp"
+#include "softrast/image.hpp"
+
+namespace softrast {
+namespace {
+
+using test::CliFolder;
+using test::CliResult;
+
+// A 2 x 2 square facing +z (counter-clockwise seen from +z), with uvs: single-sided geometry.
+constexpr const char* kQuadObj =
+    "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+    "f 1/1 2/2 3/3 4/4\n";
+
+// A texture symmetric left to right (seen from behind, the quad shows it mirrored) whose top
+// and bottom halves differ.
+Image symmetric_texture() {
+  Image image(8, 8);
+  for (int y = 0; y < 8; ++y) {
+    for (int x = 0; x < 8; ++x) {
+      int from_edge = std::min(x, 7 - x);
+      uint8_t* p = image.pixel(x, y);
+      p[0] = uint8_t(40 + 60 * from_edge), p[1] = y < 4 ? 200 : 60, p[2] = 90, p[3] = 255;
+    }
+  }
+  return image;
+}
+
+int channel(const Image& image, int x, int y, int c) {
+  return image.pixel(x, y)[c];
+}
+
+// The largest channel difference between two images of the same size.
+int worst_difference(const Image& a, const Image& b) {
+  int worst = 0;
+  for (size_t i = 0; i < a.rgba.size(); ++i)
+    worst = std::max(worst, std::abs(a.rgba[i] - b.rgba[i]));
+  return worst;
+}
+
+bool is_background(const Image& image, int x, int y, const std::vector<int>& background) {
+  for (int c = 0; c < 3; ++c) {
+    if (channel(image, x, y, c) != background[size_t(c)]) return false;
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Two-sided lighting: the quad seen from behind gives the same image as the quad seen from the
+// front, within 1/255, for every built-in lit shader and for the unlit ones. The two set-ups are
+// mirror images of each other through the quad's plane (camera, headlight, flipped normal, and
+// the texture, which is symmetric left to right), so every pixel must match. With one-sided
+// lighting the back is lit by the ambient term only.
+
+TEST(CliTwoSided, QuadSeenFromBothSidesIsLitTheSame) {
+  CliFolder folder;
+  folder.write("quad.obj", kQuadObj);
+  ASSERT_TRUE(save_image(folder.path("texture.png"), symmetric_texture()).ok());
+  const std::string kCamera = " --size 64x64 --target 0,0,0 --up 0,1,0 --fov 50";
+  for (const char* shading :
+       {"--shader gouraud", "--shader phong", "--shader phong --texture texture.png",
+        "--shader texture --texture texture.png", "--shader flat",
+        "--shader phong --reference-path", "--shader gouraud --raster scanline"}) {
+    SCOPED_TRACE(shading);
+    Image front = folder.render(std::string("quad.obj ") + shading + kCamera + " --eye 0,0,4");
+    Image back = folder.render(std::string("quad.obj ") + shading + kCamera + " --eye 0,0,-4");
+    ASSERT_FALSE(front.rgba.empty());
+    ASSERT_FALSE(back.rgba.empty());
+    // The quad covers the middle of the image, lit (not the clear colour) from both sides.
+    EXPECT_GT(channel(front, 32, 32, 0), 60);
+    ASSERT_EQ(front.rgba.size(), back.rgba.size());
+    EXPECT_LE(worst_difference(front, back), 1);
+  }
+}
+
+TEST(CliTwoSided, CullBackStillRemovesTheBackFace) {
+  CliFolder folder;
+  folder.write("quad.obj", kQuadObj);
+  Image back = folder.render("quad.obj --size 32x32 --eye 0,0,-4 --target 0,0,0 --cull back");
+  ASSERT_FALSE(back.rgba.empty());
+  for (size_t i = 0; i < back.rgba.size(); i += 4) {
+    ASSERT_EQ(back.rgba[i], to_unorm8(0.1f)) << "pixel " << i / 4;  // the background only
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The light's terms: albedo * (ambient + 0.85 * intensity * n.l).
+
+TEST(CliLight, AmbientAndIntensityScaleTheTerms) {
+  CliFolder folder;
+  folder.write("quad.obj", kQuadObj);
+  const std::string kBase = "quad.obj --size 32x32 --shader gouraud --color 0.8,0.8,0.8";
+  auto red = [&](const std::string& flags) {
+    Image image = folder.render(kBase + " " + flags);
+    return image.rgba.empty() ? -1 : channel(image, 16, 16, 0);
+  };
+  EXPECT_EQ(red("--light 0,0,1 --ambient 0.3 --light-intensity 0.5"),
+            to_unorm8(0.8f * (0.3f + 0.85f * 0.5f)));
+  EXPECT_EQ(red("--light 0,0,1 --ambient 0 --light-intensity 0"), 0);
+  EXPECT_EQ(red("--light 0,0,1 --ambient 0.05 --light-intensity 1"),
+            to_unorm8(0.8f * (0.05f + 0.85f)));
+  // Lit from behind, with --cull back so that the face is not flipped: ambient only.
+  EXPECT_EQ(red("--light 0,0,-1 --ambient 0.4 --light-intensity 3 --cull back"),
+            to_unorm8(0.8f * 0.4f));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The depth view spreads its ramp over the depths in the image: a floor seen at a slant has
+// its nearest pixels (bottom rows) white and its farthest (top rows) black, whatever the near
+// and far planes.
+
+TEST(CliDepthView, RampSpansTheVisibleDepths) {
+  CliFolder folder;
+  folder.write("floor.obj", "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nf 3 2 1\nf 4 3 1\n");
+  // Near and far planes far beyond the floor: the camera's range would leave it mid-grey.
+  Image image = folder.render(
+      "floor.obj --shader depth --size 160x120 --background 0,0,1 --eye 0,1.5,2.5 "
+      "--target 0,0,0 --near 0.1 --far 100");
+  ASSERT_FALSE(image.rgba.empty());
+  int top = -1, bottom = -1;  // the first and last rows with floor pixels
+  int lightest = 0, darkest = 255;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      if (is_background(image, x, y, {0, 0, 255})) continue;
+      if (top < 0) top = y;
+      bottom = y;
+      lightest = std::max(lightest, channel(image, x, y, 0));
+      darkest = std::min(darkest, channel(image, x, y, 0));
+    }
+  }
+  ASSERT_GE(top, 0);
+  EXPECT_GE(lightest, 250);
+  EXPECT_LE(darkest, 5);
+  // Row by row: the bottom (near) row near white, the top (far) row near black.
+  auto row_mean = [&](int y) {
+    int sum = 0, n = 0;
+    for (int x = 0; x < image.width; ++x) {
+      if (!is_background(image, x, y, {0, 0, 255})) sum += channel(image, x, y, 0), ++n;
+    }
+    return n ? sum / n : -1;
+  };
+  EXPECT_GE(row_mean(bottom), 240);
+  EXPECT_LE(row_mean(top), 15);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The overlay's colour.
+
+TEST(CliEdgeColor, OverlayDrawsInTheGivenColour) {
+  CliFolder folder;
+  folder.write("floor.obj", "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nf 3 2 1\nf 4 3 1\n");
+  auto red_pixels = [&](const std::string& flags) {
+    Image image = folder.render("floor.obj --shader flat --size 160x120 --wireframe " + flags);
+    int n = 0;
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) {
+        n += channel(image, x, y, 0) == 255 && channel(image, x, y, 1) == 0 &&
+             channel(image, x, y, 2) == 0;
+      }
+    }
+    return n;
+  };
+  EXPECT_EQ(red_pixels(""), 0);
+  EXPECT_GT(red_pixels("--edge-color 1,0,0"), 300);  // four sides and a diagonal
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scenes of several files: each file with its own materials (both name theirs "paint"), drawn
+// and framed together exactly as one file that merges them.
+
+TEST(CliScene, TwoFilesRenderAsTheirMerge) {
+  CliFolder folder;
+  folder.write("parts/a.obj",
+               "mtllib a.mtl\nv -2 -1 0\nv 0 -1 0\nv 0 1 0\nv -2 1 0\nvn 0 0 1\n"
+               "usemtl paint\nf 1//1 2//1 3//1 4//1\n");
+  folder.write("parts/a.mtl", "newmtl paint\nKd 1 0 0\n");
+  folder.write("parts/b.obj",
+               "mtllib b.mtl\nv 0.5 -1 -1\nv 3 -1 -1\nv 1.5 2 -1\nvn 0 0.3 1\n"
+               "usemtl paint\nf 1//1 2//1 3//1\n");
+  folder.write("parts/b.mtl", "newmtl paint\nKd 0 0 1\n");
+  folder.write("merged.obj",
+               "mtllib merged.mtl\nv -2 -1 0\nv 0 -1 0\nv 0 1 0\nv -2 1 0\nvn 0 0 1\n"
+               "usemtl paint_a\nf 1//1 2//1 3//1 4//1\n"
+               "v 0.5 -1 -1\nv 3 -1 -1\nv 1.5 2 -1\nvn 0 0.3 1\n"
+               "usemtl paint_b\nf 5//2 6//2 7//2\n");
+  folder.write("merged.mtl", "newmtl paint_a\nKd 1 0 0\nnewmtl paint_b\nKd 0 0 1\n");
+  const std::string kFlags = " --size 160x90 --view iso";
+  Image merged = folder.render("merged.obj" + kFlags, "merged.png");
+  Image two = folder.render("parts/a.obj parts/b.obj" + kFlags, "two.png");
+  Image from_folder = folder.render("parts" + kFlags, "folder.png");
+  ASSERT_FALSE(merged.rgba.empty());
+  EXPECT_TRUE(two.rgba == merged.rgba);
+  EXPECT_TRUE(from_folder.rgba == merged.rgba);
+  // Both materials are there: a red pixel and a blue one.
+  bool red = false, blue = false;
+  for (size_t i = 0; i < two.rgba.size(); i += 4) {
+    red |= two.rgba[i] > 40 && two.rgba[i + 1] < 10 && two.rgba[i + 2] < 10;
+    blue |= two.rgba[i + 2] > 40 && two.rgba[i] < 10 && two.rgba[i + 1] < 10;
+  }
+  EXPECT_TRUE(red);
+  EXPECT_TRUE(blue);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Framing: for every view and for wide, square and tall images, the model's pixels fill at
+// least 85% of the image's width or height and touch no border (nothing cut off).
+
+// A long, lopsided part far from the origin: a 6 x 1 x 2 box with a spike at one end.
+std::string long_part_obj() {
+  std::ostringstream obj;
+  const float x0 = 3, x1 = 9, y0 = 2, y1 = 3, z0 = -7, z1 = -5;
+  for (int i = 0; i < 8; ++i) {
+    obj << "v " << (i & 1 ? x1 : x0) << " " << (i & 2 ? y1 : y0) << " " << (i & 4 ? z1 : z0)
+        << "\n";
+  }
+  obj << "v 9 2.5 -9\n";  // the spike's tip
+  // Faces wound counter-clockwise seen from outside.
+  obj << "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+  obj << "f 2 1 9\nf 4 2 9\nf 3 4 9\nf 1 3 9\n";
+  return obj.str();
+}
+
+struct Extent {
+  int left, right, top, bottom;  // model pixels, inclusive; left > right when none
+};
+
+Extent model_extent(const Image& image) {
+  Extent e{image.width, -1, image.height, -1};
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      if (is_background(image, x, y, {0, 0, 0})) continue;
+      e.left = std::min(e.left, x), e.right = std::max(e.right, x);
+      e.top = std::min(e.top, y), e.bottom = std::max(e.bottom, y);
+    }
+  }
+  return e;
+}
+
+void expect_framed(const Image& image, const std::string& what) {
+  Extent e = model_extent(image);
+  ASSERT_LE(e.left, e.right) << what << ": no model pixel";
+  double width_share = double(e.right - e.left + 1) / image.width;
+  double height_share = double(e.bottom - e.top + 1) / image.height;
+  EXPECT_GE(std::max(width_share, height_share), 0.85)
+      << what << ": fills " << width_share << " of the width, " << height_share << " of the height";
+  EXPECT_GT(e.left, 0) << what << ": cut off on the left";
+  EXPECT_GT(e.top, 0) << what << ": cut off at the top";
+  EXPECT_LT(e.right, image.width - 1) << what << ": cut off on the right";
+  EXPECT_LT(e.bottom, image.height - 1) << what << ": cut off at the bottom";
+}
+
+TEST(CliFraming, EveryViewFillsTheLimitingSide) {
+  CliFolder folder;
+  folder.write("part.obj", long_part_obj());
+  for (const char* size : {"192x108", "128x128", "108x192"}) {
+    for (const char* view : {"front", "back", "left", "right", "top", "bottom", "iso"}) {
+      std::string args = std::string("part.obj --shader flat --background 0,0,0 --size ") + size +
+                         " --view " + view;
+      expect_framed(folder.render(args), args);
+    }
+  }
+}
+
+TEST(CliFraming, AnglesUpAxesAndZoom) {
+  CliFolder folder;
+  folder.write("part.obj", long_part_obj());
+  for (const char* flags :
+       {"--azimuth 30 --elevation 20", "--azimuth -150 --elevation -60", "--up-axis +z",
+        "--up-axis -x --view iso", "--fov 20 --view right", "--fov 100 --view top"}) {
+    std::string args =
+        std::string("part.obj --shader flat --background 0,0,0 --size 160x90 ") + flags;
+    expect_framed(folder.render(args), args);
+  }
+  // --zoom 0.5 halves the extent along the limiting side (within a pixel or two).
+  Extent full = model_extent(
+      folder.render("part.obj --shader flat --background 0,0,0 --size 200x200 --view front"));
+  Extent half = model_extent(folder.render(
+      "part.obj --shader flat --background 0,0,0 --size 200x200 --view front --zoom 0.5"));
+  EXPECT_NEAR(half.right - half.left + 1, (full.right - full.left + 1) * 0.5, 3.0);
+}
+
+// A view preset is its azimuth and elevation.
+TEST(CliFraming, ViewPresetsAreAngles) {
+  CliFolder folder;
+  folder.write("part.obj", long_part_obj());
+  const std::string kBase = "part.obj --size 96x72";
+  EXPECT_TRUE(folder.render(kBase + " --view right", "a.png").rgba ==
+              folder.render(kBase + " --azimuth 90 --elevation 0", "b.png").rgba);
+  EXPECT_TRUE(folder.render(kBase + " --view top", "a.png").rgba ==
+              folder.render(kBase + " --elevation 90", "b.png").rgba);
+}
+
+// The same part made Z-up ((x, y, z) -> (x, -z, y)) and framed with --up-axis +z looks as the
+// Y-up part does by default: up is up and the front is the front.
+TEST(CliFraming, UpAxisZShowsAZUpModelUpright) {
+  CliFolder folder;
+  std::string y_up = long_part_obj(), z_up;
+  std::istringstream in(y_up);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("v ", 0) == 0) {
+      std::istringstream v(line.substr(2));
+      float x, y, z;
+      v >> x >> y >> z;
+      std::ostringstream out;
+      out << "v " << x << " " << -z << " " << y;
+      z_up += out.str() + "\n";
+    } else {
+      z_up += line + "\n";
+    }
+  }
+  folder.write("y_up.obj", y_up);
+  folder.write("z_up.obj", z_up);
+  for (const char* view : {"front", "iso", "left"}) {
+    SCOPED_TRACE(view);
+    const std::string kFlags = std::string(" --shader flat --size 120x90 --view ") + view;
+    Image a = folder.render("y_up.obj" + kFlags, "y.png");
+    Image b = folder.render("z_up.obj --up-axis +z" + kFlags, "z.png");
+    ASSERT_EQ(a.rgba.size(), b.rgba.size());
+    int differing = 0;
+    for (size_t i = 0; i < a.rgba.size(); i += 4) differing += a.rgba[i] != b.rgba[i];
+    EXPECT_LE(differing, 120 * 90 / 100);  // rounding on a few edge pixels at most
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Background and opacity, read back from the PNG's alpha channel.
+
+TEST(CliBackground, AlphaZeroGivesATransparentPng) {
+  CliFolder folder;
+  folder.write("quad.obj", kQuadObj);
+  Image image = folder.render("quad.obj --size 48x32 --background 1,0.5,0,0");
+  ASSERT_FALSE(image.rgba.empty());
+  EXPECT_EQ(std::vector<int>(image.pixel(0, 0), image.pixel(0, 0) + 4),
+            (std::vector<int>{255, to_unorm8(0.5f), 0, 0}));
+  EXPECT_EQ(channel(image, 24, 16, 3), 255);  // the model is opaque
+  Image faint = folder.render("quad.obj --size 48x32 --background 0,0,0,0 --alpha 0.5");
+  ASSERT_FALSE(faint.rgba.empty());
+  EXPECT_EQ(channel(faint, 24, 16, 3), to_unorm8(0.5f));  // --alpha: the model's opacity
+  EXPECT_EQ(channel(faint, 0, 0, 3), 0);
+  Image opaque = folder.render("quad.obj --size 48x32 --background 0.2,0.4,0.6");
+  ASSERT_FALSE(opaque.rgba.empty());
+  EXPECT_EQ(std::vector<int>(opaque.pixel(0, 0), opaque.pixel(0, 0) + 4),
+            (std::vector<int>{to_unorm8(0.2f), to_unorm8(0.4f), to_unorm8(0.6f), 255}));
+}
+
+}  // namespace
+}  // namespace softrast
+
+#endif  // SOFTRAST_CLI_PATH
