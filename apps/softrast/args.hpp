@@ -32,6 +32,7 @@ struct RawArgs {
   std::string wrap = "repeat";
   std::optional<int> frames;
   bool quiet = false;
+  std::optional<int> quality;  // JPEG output quality, 1..100
 };
 
 // Adds every flag of the render command to `app`, storing into `args`.

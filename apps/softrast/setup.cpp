@@ -14,6 +14,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -96,13 +97,6 @@ bool in_unit_range(float x) {
   return x >= 0.0f && x <= 1.0f;
 }
 
-std::string lowercase_extension(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
-}
-
 constexpr int kMaxThreads = 1024;
 
 void interpret_state(const RawArgs& a, RenderState& state, FirstError& e) {
@@ -171,6 +165,25 @@ void interpret_camera(const RawArgs& a, CameraFlags& c, FirstError& e) {
   check_camera_flags(c, e);
 }
 
+// The output's format: .png, .jpg/.jpeg, .tga, or "-" (PNG on the standard output); --quality.
+void interpret_image_output(const RawArgs& a, JobSpec& spec, FirstError& e) {
+  bool to_stdout = spec.output && *spec.output == "-";
+  std::optional<ImageFormat> format;
+  if (spec.output && !to_stdout) {
+    format = image_format_of(*spec.output);
+    e.fail_if(!format, *spec.output +
+                           ": unknown image format (the output must end in .png, .jpg or .tga, "
+                           "or be - for the standard output)");
+  }
+  e.fail_if(to_stdout && spec.frames > 0,
+            "-o -: cannot be combined with --frames (both write to the standard output)");
+  if (a.quality) {
+    e.fail_if(*a.quality < 1 || *a.quality > 100, "--quality: must be in 1..100");
+    e.fail_if(format != ImageFormat::kJpeg, "--quality: only for .jpg output");
+    spec.jpeg_quality = *a.quality;
+  }
+}
+
 void interpret_output(const RawArgs& a, JobSpec& spec, FirstError& e) {
   if (a.size) {
     glm::ivec2 size(0);
@@ -185,11 +198,7 @@ void interpret_output(const RawArgs& a, JobSpec& spec, FirstError& e) {
   }
   spec.output = a.output;
   if (!spec.output && spec.frames == 0) spec.output = "softrast.png";
-  if (spec.output) {
-    std::string ext = lowercase_extension(*spec.output);
-    e.fail_if(ext != ".png" && ext != ".tga",
-              *spec.output + ": unknown image format (the output must end in .png or .tga)");
-  }
+  interpret_image_output(a, spec, e);
 }
 
 // The folder must exist and be writable now, not after a long render.
@@ -230,9 +239,15 @@ Result<Scene> load_scene(const JobSpec& spec) {
     scene.camera = demo.camera;
     apply_flags(scene.camera, spec.camera);
   } else {
-    Result<Mesh> mesh = load_obj(*spec.model);
+    Result<Mesh> mesh = load_model(*spec.model);
     if (!mesh) return mesh.status();
     scene.mesh = std::move(*mesh);
+    // What the loader worked around (a missing MTL or texture): the render goes on.
+    if (!spec.quiet) {
+      for (const std::string& w : scene.mesh.warnings) {
+        std::fprintf(stderr, "softrast: warning: %s\n", w.c_str());
+      }
+    }
     float aspect = float(spec.width) / float(spec.height);
     scene.camera = frame_model(bounds_of(scene.mesh), spec.camera, aspect);
   }
@@ -261,7 +276,10 @@ Result<JobSpec> interpret(const RawArgs& args) {
 }
 
 Result<Job> prepare(const JobSpec& spec) {
-  if (spec.output) {
+  if (spec.output && *spec.output == "-" && ::isatty(STDOUT_FILENO)) {
+    return Status::error("-o -: the standard output is a terminal; redirect it to a file or pipe");
+  }
+  if (spec.output && *spec.output != "-") {
     if (Status s = check_output_path(*spec.output); !s.ok()) return s;
   }
   RenderOptions options = spec.options;
@@ -285,6 +303,7 @@ Result<Job> prepare(const JobSpec& spec) {
   job.output = spec.output;
   job.frames = spec.frames;
   job.quiet = spec.quiet;
+  job.jpeg_quality = spec.jpeg_quality;
   return job;
 }
 

@@ -12,6 +12,7 @@
 #include "framing.hpp"
 #include "softrast/camera.hpp"
 #include "softrast/framebuffer.hpp"
+#include "softrast/image.hpp"
 #include "softrast/mesh.hpp"
 #include "softrast/renderer.hpp"
 #include "softrast/status.hpp"
@@ -32,6 +33,7 @@ struct JobSpec {
   bool headlight = true;
   int frames = 0;  // 0: one untimed render
   bool quiet = false;
+  int jpeg_quality = kDefaultJpegQuality;
 };
 
 // The mesh and the camera to see it with.
@@ -53,6 +55,7 @@ struct Job {
   std::optional<std::string> output;
   int frames = 0;
   bool quiet = false;
+  int jpeg_quality = kDefaultJpegQuality;  // for .jpg output
 };
 
 Result<JobSpec> interpret(const RawArgs& args);
