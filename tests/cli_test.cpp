@@ -515,7 +515,7 @@ const BadInput kBadInputs[] = {
     {"OutputExtensionBmp", "-o out.bmp"},
     {"OutputNoExtension", "-o out"},
     {"OutputIsAFolder", "-o ."},
-    {"OutputExtensionWithModel", "quad.obj -o out.jpg"},
+    {"OutputExtensionWithModel", "quad.obj -o out.gif"},
     {"FramesWithBadOutput", "--frames 2 -o /nonexistent/dir/out.png"},
 };
 

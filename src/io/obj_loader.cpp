@@ -39,6 +39,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include <malloc.h>
+
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
@@ -148,6 +150,7 @@ class VertexTable {
   }
 
   const std::vector<Key>& keys() const { return keys_; }
+  void release_keys() { keys_ = {}; }
   void release_lookup() {
     head_ = {};
     next_ = {};
@@ -191,6 +194,15 @@ glm::vec3 unit_or_z(const glm::dvec3& n) {
   return glm::vec3(n / length);
 }
 
+// Pieces are allocated by the worker threads (in their malloc arenas) and freed here, and the raw
+// arrays are freed before the final ones grow: glibc keeps such memory mapped, counted in the
+// resident size, until told to give back its free pages (malloc_trim returns whole free pages
+// from every arena, not only from the top of the heap). Every few pieces and once before the
+// indices are joined; each call takes well under a millisecond.
+constexpr size_t kTrimEvery = 8;
+
+void return_free_memory() { malloc_trim(0); }
+
 // Merges parsed pieces in file order into the mesh, then finishes it.
 class ObjMerge {
  public:
@@ -227,6 +239,7 @@ class ObjMerge {
   std::vector<SubMesh> submeshes_;
   int material_ = -1;
   size_t face_ = 0, corner_ = 0;  // cursor in the piece being merged
+  size_t pieces_ = 0;
 };
 
 Status ObjMerge::piece_error(const ObjPiece& piece) const {
@@ -325,28 +338,26 @@ Status ObjMerge::merge(ObjPiece& piece) {
   index_count_ += indices.size();
   if (!indices.empty()) index_pieces_.push_back(std::move(indices));
   lines_ += piece.lines;
+  if (++pieces_ % kTrimEvery == 0) return_free_memory();
   return {};
 }
 
-// The final arrays, built one at a time while the raw ones are released, so that at most one
-// array exists twice.
+// The final arrays, built one at a time while the raw ones are released: the vertex arrays
+// first (each raw array freed once its final one is built), then the lookup table and keys, and
+// only then are the per-piece indices joined, so that at most one array exists twice.
 Mesh ObjMerge::build_mesh() {
   Mesh mesh;
   mesh.submeshes = std::move(submeshes_);
   table_.release_lookup();
-  mesh.indices.reserve(index_count_);
-  for (std::vector<uint32_t>& piece : index_pieces_) {
-    mesh.indices.insert(mesh.indices.end(), piece.begin(), piece.end());
-    piece = {};
-  }
-  index_pieces_ = {};
   const std::vector<VertexTable::Key>& keys = table_.keys();
   mesh.positions.resize(keys.size());
   for (size_t i = 0; i < keys.size(); ++i) {
     const float* p = values_[0].at(size_t(keys[i].v));
     mesh.positions[i] = {p[0], p[1], p[2]};
   }
+  size_t position_count = values_[0].count();
   values_[0].release();
+  return_free_memory();
   mesh.uvs.resize(keys.size(), glm::vec2(0.0f));
   for (size_t i = 0; i < keys.size(); ++i) {
     if (keys[i].vt < 0) continue;
@@ -354,6 +365,7 @@ Mesh ObjMerge::build_mesh() {
     mesh.uvs[i] = {t[0], t[1]};
   }
   values_[1].release();
+  return_free_memory();
   mesh.normals.resize(keys.size(), glm::vec3(0.0f));
   bool needs_smoothing = false;
   for (size_t i = 0; i < keys.size(); ++i) {
@@ -365,14 +377,30 @@ Mesh ObjMerge::build_mesh() {
     mesh.normals[i] = {n[0], n[1], n[2]};
   }
   values_[2].release();
+  std::vector<uint32_t> position_index;
+  if (needs_smoothing) {
+    position_index.resize(keys.size());
+    for (size_t v = 0; v < keys.size(); ++v) position_index[v] = uint32_t(keys[v].v);
+  }
+  std::vector<bool> smooth;
+  if (needs_smoothing) {
+    smooth.resize(keys.size());
+    for (size_t v = 0; v < keys.size(); ++v) smooth[v] = keys[v].vn < 0;
+  }
+  table_.release_keys();
+  return_free_memory();
+  mesh.indices.reserve(index_count_);
+  for (std::vector<uint32_t>& piece : index_pieces_) {
+    mesh.indices.insert(mesh.indices.end(), piece.begin(), piece.end());
+    piece = {};
+  }
+  index_pieces_ = {};
   // Missing normals become smooth normals per OBJ position index, so vertices that share a
   // position but not a uv still get the same normal.
   if (needs_smoothing) {
-    std::vector<uint32_t> position_index(keys.size());
-    for (size_t v = 0; v < keys.size(); ++v) position_index[v] = uint32_t(keys[v].v);
-    auto sums = group_normal_sums(mesh, position_index, values_[0].count());
-    for (size_t v = 0; v < keys.size(); ++v) {
-      if (keys[v].vn < 0) mesh.normals[v] = unit_or_z(sums[position_index[v]]);
+    auto sums = group_normal_sums(mesh, position_index, position_count);
+    for (size_t v = 0; v < smooth.size(); ++v) {
+      if (smooth[v]) mesh.normals[v] = unit_or_z(sums[position_index[v]]);
     }
   }
   return mesh;
@@ -539,7 +567,7 @@ int parse_threads() {
 // Pieces read, parsed by the workers and merged in order, at most kWindow at a time.
 Status parse_in_parallel(PieceReader& reader, std::vector<char> first, ObjMerge& merge) {
   int threads = parse_threads();
-  const size_t window_limit = size_t(threads) + 2;
+  const size_t window_limit = size_t(threads) + 1;
   std::deque<std::unique_ptr<ObjPiece>> window;  // declared first: outlives the workers
   PieceWorkers workers(threads);
   auto submit = [&](std::vector<char>&& text) {

@@ -22,12 +22,61 @@ std::string quoted(std::string_view word) {
   return text += '\'';
 }
 
+// Exact powers of ten as doubles (10^22 is the largest that is).
+constexpr double kPow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                               1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+// The common case of an OBJ number, "-15.500000", read from p (which is advanced past it): at
+// most 19 digits in all, no exponent. The digits as an integer m <= 2^53 and 10^k with k <= 22
+// are both exact doubles, so m / 10^k is the correctly rounded value (Clinger's fast path), the
+// same double std::from_chars gives. False for anything else, which goes to std::from_chars.
+bool parse_decimal_at(const char*& p, const char* end, double& value) {
+  bool negative = p < end && *p == '-';
+  if (negative) ++p;
+  uint64_t m = 0;
+  int digits = 0, fraction = 0;
+  for (; p < end && is_digit(*p); ++p, ++digits) m = m * 10 + uint64_t(*p - '0');
+  if (p < end && *p == '.') {
+    for (++p; p < end && is_digit(*p); ++p, ++digits, ++fraction) m = m * 10 + uint64_t(*p - '0');
+  }
+  if (digits == 0 || digits > 19 || m > (uint64_t(1) << 53) || fraction > 22) return false;
+  value = double(m) / kPow10[fraction];
+  if (negative) value = -value;
+  return true;
+}
+
+bool parse_simple_decimal(std::string_view word, double& value) {
+  const char* p = word.data();
+  const char* end = p + word.size();
+  return parse_decimal_at(p, end, value) && p == end;
+}
+
+// A word of 1 to 18 digits, optionally after '-', as an integer; false for anything else (which
+// std::from_chars then classifies: not an index, or out of range).
+bool parse_simple_integer(std::string_view word, int64_t& value) {
+  const char* p = word.data();
+  const char* end = p + word.size();
+  bool negative = p < end && *p == '-';
+  if (negative) ++p;
+  if (p == end || end - p > 18) return false;
+  int64_t v = 0;
+  for (; p < end; ++p) {
+    if (!is_digit(*p)) return false;
+    v = v * 10 + (*p - '0');
+  }
+  value = negative ? -v : v;
+  return true;
+}
+
 class PieceParser {
  public:
   explicit PieceParser(ObjPiece& piece) : p_(piece) {}
 
   // False once the line had an error (recorded in the piece).
   bool line(std::string_view text) {
+    if (fast_line(text.data(), text.data() + text.size())) return true;
     ObjWords words(text);
     std::string_view keyword = words.next();
     if (keyword.size() == 1 && keyword[0] == 'v') return numbers(words, kObjPositions, 3);
@@ -90,10 +139,13 @@ class PieceParser {
   // One index of corner `corner`: 1-based, or negative counting back from the latest element.
   bool resolve(std::string_view word, int attr, size_t corner) {
     int64_t value = 0;
-    auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), value);
-    bool overflow = ec == std::errc::result_out_of_range;
-    if (!overflow && (ec != std::errc() || end != word.data() + word.size())) {
-      return error("bad face corner: " + quoted(word) + " is not an index");
+    bool overflow = false;
+    if (!parse_simple_integer(word, value)) {
+      auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), value);
+      overflow = ec == std::errc::result_out_of_range;
+      if (!overflow && (ec != std::errc() || end != word.data() + word.size())) {
+        return error("bad face corner: " + quoted(word) + " is not an index");
+      }
     }
     int32_t& slot = p_.corners[corner].index[attr];
     int64_t local = int64_t(count(attr));
@@ -153,6 +205,93 @@ class PieceParser {
     return true;
   }
 
+  // Fast paths for the lines that make up nearly all of a large file: v, vt and vn with plain
+  // decimals, and f with positive indices. Each accepts only what the general path accepts and
+  // gives the same result; anything else (every error included) is left to the general path.
+  static bool is_blank(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+  }
+
+  bool fast_line(const char* p, const char* end) {
+    while (p < end && is_blank(*p)) ++p;
+    if (end - p < 2) return false;
+    if (p[0] == 'v' && is_blank(p[1])) return fast_numbers(p + 1, end, kObjPositions);
+    if (p[0] == 'f' && is_blank(p[1])) return fast_face(p + 1, end);
+    if (end - p < 3 || p[0] != 'v' || !is_blank(p[2])) return false;
+    if (p[1] == 't') return fast_numbers(p + 2, end, kObjUvs);
+    if (p[1] == 'n') return fast_numbers(p + 2, end, kObjNormals);
+    return false;
+  }
+
+  // Exactly as many plain decimals as the array stores, then the end or a comment.
+  bool fast_numbers(const char* p, const char* end, int attr) {
+    float v[3];
+    size_t count = kObjComponents[attr];
+    for (size_t k = 0; k < count; ++k) {
+      if (p == end || !is_blank(*p)) return false;
+      while (p < end && is_blank(*p)) ++p;
+      double d = 0.0;
+      if (!parse_decimal_at(p, end, d) || (p != end && !is_blank(*p))) return false;
+      if (!(std::fabs(d) <= double(std::numeric_limits<float>::max()))) return false;
+      v[k] = float(d);
+    }
+    while (p < end && is_blank(*p)) ++p;
+    if (p != end && *p != '#') return false;
+    p_.values[attr].insert(p_.values[attr].end(), v, v + count);
+    return true;
+  }
+
+  // 1 to 9 digits, not 0: a positive index that needs no range check beyond the final count.
+  bool fast_index(const char*& p, const char* end, int attr, int32_t& slot) {
+    const char* start = p;
+    int64_t value = 0;
+    while (p < end && is_digit(*p) && p - start < 10) value = value * 10 + (*p++ - '0');
+    if (p == start || p - start > 9 || value == 0) return false;
+    if (value > p_.largest[attr].value) p_.largest[attr] = {value, line_};
+    slot = int32_t(value - 1);
+    return true;
+  }
+
+  bool fast_corner(const char*& p, const char* end, ObjCorner& c) {
+    if (!fast_index(p, end, kObjPositions, c.index[0])) return false;
+    if (p < end && *p == '/') {
+      ++p;
+      if (p < end && *p == '/') {
+        ++p;
+        if (!fast_index(p, end, kObjNormals, c.index[2])) return false;
+      } else {
+        if (!fast_index(p, end, kObjUvs, c.index[1])) return false;
+        if (p < end && *p == '/') {
+          ++p;
+          if (!fast_index(p, end, kObjNormals, c.index[2])) return false;
+        }
+      }
+    }
+    return p == end || is_blank(*p);
+  }
+
+  bool fast_face(const char* p, const char* end) {
+    size_t first = p_.corners.size();
+    for (;;) {
+      while (p < end && is_blank(*p)) ++p;
+      if (p == end || *p == '#') break;
+      ObjCorner c{{0, kObjAbsent, kObjAbsent}};
+      if (!fast_corner(p, end, c)) {
+        p_.corners.resize(first);
+        return false;
+      }
+      p_.corners.push_back(c);
+    }
+    size_t n = p_.corners.size() - first;
+    if (n < 3) {
+      p_.corners.resize(first);
+      return false;
+    }
+    p_.face_sizes.push_back(uint32_t(n));
+    p_.triangles += n - 2;
+    return true;
+  }
+
   ObjPiece& p_;
   size_t line_ = 0;
 };
@@ -188,9 +327,11 @@ void parse_lines(ObjPiece& piece) {
 ObjNumber parse_obj_float(std::string_view word, float& value) {
   if (word.size() > 1 && word[0] == '+' && word[1] != '-') word.remove_prefix(1);
   double d = 0.0;
-  auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), d);
-  if (ec == std::errc::result_out_of_range) return ObjNumber::kOutOfRange;
-  if (ec != std::errc() || end != word.data() + word.size()) return ObjNumber::kNotNumber;
+  if (!parse_simple_decimal(word, d)) {
+    auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), d);
+    if (ec == std::errc::result_out_of_range) return ObjNumber::kOutOfRange;
+    if (ec != std::errc() || end != word.data() + word.size()) return ObjNumber::kNotNumber;
+  }
   if (!(std::fabs(d) <= double(std::numeric_limits<float>::max()))) return ObjNumber::kOutOfRange;
   value = float(d);
   return ObjNumber::kOk;
