@@ -139,6 +139,33 @@ TEST_F(CliIoTest, LoaderWarningsArePrintedUnlessQuiet) {
   EXPECT_EQ(quiet.err, "");
 }
 
+TEST_F(CliIoTest, PlyAndStlModelsRenderAndOtherFilesSayWhatTheyAre) {
+  const std::string tetra_stl =
+      "solid t\n"
+      "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\n"
+      "endfacet\nendsolid t\n";
+  write("t.stl", tetra_stl);
+  write("t.ply",
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n");
+  CliResult obj = run("t.obj --size 48x32 -q -o obj.png");
+  CliResult stl = run("t.stl --size 48x32 -q -o stl.png");
+  CliResult ply = run("t.ply --size 48x32 -q -o ply.png");
+  ASSERT_EQ(obj.exit_code, 0) << obj.err;
+  ASSERT_EQ(stl.exit_code, 0) << stl.err;
+  ASSERT_EQ(ply.exit_code, 0) << ply.err;
+  EXPECT_EQ(read_file(dir_ / "stl.png"), read_file(dir_ / "obj.png"));
+  EXPECT_EQ(read_file(dir_ / "ply.png"), read_file(dir_ / "obj.png"));
+  CliResult png = run("obj.png -o x.png");
+  EXPECT_EQ(png.exit_code, 1);
+  EXPECT_EQ(png.err,
+            "softrast: error: obj.png: this is a PNG image, not a model (softrast reads OBJ, PLY "
+            "and STL)\n");
+  EXPECT_FALSE(fs::exists(dir_ / "x.png"));
+}
+
 }  // namespace
 }  // namespace softrast
 

@@ -8,8 +8,8 @@ namespace {
 
 void define_output_flags(CLI::App& app, RawArgs& a) {
   app.add_option("MODEL", a.model,
-                 "Wavefront OBJ file (positions in world space); without it, "
-                 "the built-in demo scene");
+                 "Model file: Wavefront OBJ (with its MTL materials), PLY or STL, told by its "
+                 "contents (positions in world space); without it, the built-in demo scene");
   app.add_option("-o,--out", a.output,
                  "Output image, .png, .jpg or .tga, or - for PNG on the standard output (default "
                  "softrast.png; with --frames, only if given)")
