@@ -63,16 +63,6 @@ void filter_rows(const Image& image, int y0, int y1, uint8_t* o) {
   }
 }
 
-void filter_rows(const Image& image, bool rgb, int y0, int y1, std::vector<uint8_t>& out) {
-  size_t row_bytes = 1 + size_t(image.width) * (rgb ? 3 : 4);
-  out.resize(row_bytes * size_t(y1 - y0));
-  if (rgb) {
-    filter_rows<3>(image, y0, y1, out.data());
-  } else {
-    filter_rows<4>(image, y0, y1, out.data());
-  }
-}
-
 struct Strip {
   std::vector<uint8_t> deflated;
   uLong adler = 0;
@@ -80,24 +70,61 @@ struct Strip {
   bool ok = false;
 };
 
-// One strip: filtered, then compressed as raw deflate; the last strip finishes the stream.
-void compress_strip(const Image& image, bool rgb, int y0, int y1, bool last, Strip& strip) {
-  std::vector<uint8_t> raw;
-  filter_rows(image, rgb, y0, y1, raw);
-  strip.raw_size = uLong(raw.size());
-  strip.adler = adler32(adler32(0L, Z_NULL, 0), raw.data(), uInt(raw.size()));
-  z_stream z{};
-  if (deflateInit2(&z, 1, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) != Z_OK) return;
-  strip.deflated.resize(deflateBound(&z, uLong(raw.size())) + 16);
-  z.next_in = raw.data();
-  z.avail_in = uInt(raw.size());
-  z.next_out = strip.deflated.data();
-  z.avail_out = uInt(strip.deflated.size());
-  int code = deflate(&z, last ? Z_FINISH : Z_SYNC_FLUSH);
-  strip.ok = last ? code == Z_STREAM_END : code == Z_OK && z.avail_in == 0;
-  strip.deflated.resize(z.total_out);
-  deflateEnd(&z);
-}
+// Rows filtered and fed to zlib this many at a time, so the filtered bytes never exist whole.
+constexpr int kFeedRows = 16;
+
+// Compresses whole strips, one after the other, with one zlib stream and buffers reused (fresh
+// memory costs page faults: a zlib state and a strip's worth of rows per strip would touch more
+// memory than the output). deflateReset makes each strip exactly what a new stream would give.
+class StripCompressor {
+ public:
+  StripCompressor(const Image& image, bool rgb) : image_(image), rgb_(rgb) {
+    row_bytes_ = 1 + size_t(image.width) * (rgb ? 3 : 4);
+    ok_ = deflateInit2(&z_, 1, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) == Z_OK;
+    if (ok_) out_.resize(deflateBound(&z_, uLong(row_bytes_ * kStripRows)) + 64);
+    rows_.resize(row_bytes_ * kFeedRows);
+  }
+  ~StripCompressor() {
+    if (ok_) deflateEnd(&z_);
+  }
+  StripCompressor(const StripCompressor&) = delete;
+  StripCompressor& operator=(const StripCompressor&) = delete;
+
+  // Rows [y0, y1) as one raw deflate stream, ended by a sync flush, or finished if `last`.
+  void compress(int y0, int y1, bool last, Strip& strip) {
+    if (!ok_ || deflateReset(&z_) != Z_OK) return;
+    strip.adler = adler32(0L, Z_NULL, 0);
+    z_.next_out = out_.data();
+    z_.avail_out = uInt(out_.size());
+    for (int y = y0; y < y1; y += kFeedRows) {
+      int n = std::min(kFeedRows, y1 - y);
+      if (rgb_) {
+        filter_rows<3>(image_, y, y + n, rows_.data());
+      } else {
+        filter_rows<4>(image_, y, y + n, rows_.data());
+      }
+      auto size = uInt(row_bytes_ * size_t(n));
+      strip.adler = adler32(strip.adler, rows_.data(), size);
+      strip.raw_size += size;
+      z_.next_in = rows_.data();
+      z_.avail_in = size;
+      bool end = y + n == y1;
+      int code = deflate(&z_, !end ? Z_NO_FLUSH : last ? Z_FINISH : Z_SYNC_FLUSH);
+      bool done = end && last ? code == Z_STREAM_END : code == Z_OK;
+      if (!done || z_.avail_in != 0) return;
+    }
+    strip.deflated.assign(out_.data(), z_.next_out);
+    strip.ok = true;
+  }
+
+ private:
+  const Image& image_;
+  bool rgb_;
+  bool ok_ = false;
+  size_t row_bytes_ = 0;
+  z_stream z_{};
+  std::vector<uint8_t> rows_, out_;
+};
 
 void put32(std::vector<uint8_t>& out, uint32_t v) {
   out.insert(out.end(), {uint8_t(v >> 24), uint8_t(v >> 16), uint8_t(v >> 8), uint8_t(v)});
@@ -131,10 +158,17 @@ Result<std::vector<uint8_t>> encode_png(const Image& image) {
   bool rgb = opaque(image);
   int strips = (image.height + kStripRows - 1) / kStripRows;
   std::vector<Strip> parts(static_cast<size_t>(strips));
-  parallel_for(size_t(strips), hardware_threads(), [&](size_t i) {
-    int y0 = int(i) * kStripRows;
-    int y1 = std::min(image.height, y0 + kStripRows);
-    compress_strip(image, rgb, y0, y1, int(i) == strips - 1, parts[i]);
+  // Each worker takes a run of consecutive strips; the bytes depend only on the strips.
+  int workers = std::clamp(hardware_threads(), 1, strips);
+  parallel_for(size_t(workers), workers, [&](size_t w) {
+    StripCompressor compressor(image, rgb);
+    size_t first = w * size_t(strips) / size_t(workers);
+    size_t end = (w + 1) * size_t(strips) / size_t(workers);
+    for (size_t i = first; i < end; ++i) {
+      int y0 = int(i) * kStripRows;
+      int y1 = std::min(image.height, y0 + kStripRows);
+      compressor.compress(y0, y1, int(i) == strips - 1, parts[i]);
+    }
   });
   // The zlib stream: header (deflate, 32 KiB window, "fastest" level), strips, Adler-32.
   std::vector<uint8_t> idat = {0x78, 0x01};
