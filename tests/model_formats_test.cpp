@@ -3,6 +3,7 @@
 // ASCII and binary STL, loads to the same triangles and renders the same image in each; every
 // truncation of each file is a clear error; files that are not models say what they are.
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -11,6 +12,7 @@
 #include <fstream>
 #include <functional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -338,6 +340,17 @@ TEST_F(ModelFormatsTest, MutatedFilesLoadOrFailCleanly) {
   }
   EXPECT_GT(failed, 100);
   EXPECT_GT(loaded, 10);
+}
+
+// A pipe can be read once: load_model does not sniff it, it reads it as OBJ.
+TEST_F(ModelFormatsTest, AnObjFromAPipeLoadsWhole) {
+  std::string path = (dir_ / "pipe.obj").string();
+  ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
+  std::thread writer([&] { std::ofstream(path, std::ios::binary) << obj_text(); });
+  Result<Mesh> mesh = load_model(path);
+  writer.join();
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  EXPECT_EQ(mesh->triangle_count(), 12u);
 }
 
 }  // namespace

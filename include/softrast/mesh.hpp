@@ -89,6 +89,7 @@ Result<Mesh> load_stl(const std::string& path);
 // it looks like: "x.png: this is a PNG image, not a model (softrast reads OBJ, PLY and STL)"
 // (PNG, JPEG, GIF, BMP, TGA images, glTF/GLB scenes, ZIP, PDF, gzip, ELF, FBX). A .stl or .ply
 // name whose content is neither goes to that format's loader, which says why it is not one.
+// Pipes and devices (which can be read only once) are read as OBJ.
 Result<Mesh> load_model(const std::string& path);
 
 // Fills `mesh.normals` with area-weighted smooth normals per position (used when the file has

@@ -92,7 +92,8 @@ bool starts_solid(std::string_view head) {
   return starts_with(rest, "solid") && (rest.size() == 5 || std::isspace((unsigned char)rest[5]));
 }
 
-// The first kSniffBytes of the file and its size (-1 when it has none, e.g. a pipe).
+// The first kSniffBytes of the file and its size; for a pipe or device (no size, -1) nothing
+// is read.
 Status sniff(const std::string& path, std::string& head, int64_t& size) {
   detail::FilePtr f;
   if (Status s = detail::open_text_file(path, {kMaxObjFileBytes, "model files"}, f); !s.ok()) {
@@ -100,6 +101,7 @@ Status sniff(const std::string& path, std::string& head, int64_t& size) {
   }
   struct stat info {};
   size = fstat(fileno(f.get()), &info) == 0 && S_ISREG(info.st_mode) ? int64_t(info.st_size) : -1;
+  if (size < 0) return {};  // a pipe or device: what is read here would be lost to the loader
   head.resize(kSniffBytes);
   head.resize(std::fread(head.data(), 1, head.size(), f.get()));
   if (std::ferror(f.get())) return fail(path, std::string("cannot read: ") + std::strerror(errno));
@@ -159,6 +161,7 @@ Result<Mesh> load_model(const std::string& path) {
   std::string head;
   int64_t size = -1;
   if (Status s = sniff(path, head, size); !s.ok()) return s;
+  if (size < 0) return load_obj(path);  // pipes and devices are read once, as OBJ
   if (starts_with(head, "ply\n") || starts_with(head, "ply\r\n")) return load_ply(path);
   // The size decides before "solid": some binary STL writers begin their header with it.
   if (size >= 84 && head.size() >= 84 && detail::is_binary_stl(head.data(), size_t(size))) {
