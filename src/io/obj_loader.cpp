@@ -505,17 +505,14 @@ bool PieceReader::next(std::vector<char>& text) {
 class PieceWorkers {
  public:
   explicit PieceWorkers(int count) {
-    for (int i = 0; i < count; ++i) threads_.emplace_back([this] { work(); });
-  }
-  ~PieceWorkers() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-      queue_.clear();
+    try {
+      for (int i = 0; i < count; ++i) threads_.emplace_back([this] { work(); });
+    } catch (...) {  // no thread to be had: stop those that started, then report
+      stop();
+      throw;
     }
-    work_ready_.notify_all();
-    for (std::thread& t : threads_) t.join();
   }
+  ~PieceWorkers() { stop(); }
   PieceWorkers(const PieceWorkers&) = delete;
   PieceWorkers& operator=(const PieceWorkers&) = delete;
 
@@ -533,6 +530,17 @@ class PieceWorkers {
   }
 
  private:
+  void stop() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+      queue_.clear();
+    }
+    work_ready_.notify_all();
+    for (std::thread& t : threads_) t.join();
+    threads_.clear();
+  }
+
   void work() {
     for (;;) {
       ObjPiece* piece = nullptr;
