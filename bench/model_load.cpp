@@ -30,8 +30,8 @@ int main(int argc, char** argv) {
   for (int i = 0; i < runs; ++i) {
     auto start = std::chrono::steady_clock::now();
     softrast::Result<softrast::Mesh> mesh = softrast::load_model(argv[1]);
-    double t = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                   .count();
+    double t =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     if (!mesh) {
       std::fprintf(stderr, "%s\n", mesh.status().message().c_str());
       return 1;

@@ -123,8 +123,7 @@ TEST_F(CliIoTest, BadOutputRequestsAreOneErrorLine) {
 }
 
 TEST_F(CliIoTest, LoaderWarningsArePrintedUnlessQuiet) {
-  write("m.obj",
-        "mtllib gone.mtl\nmtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+  write("m.obj", "mtllib gone.mtl\nmtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
   write("m.mtl", "newmtl a\nKd 1 0 0\nmap_Kd missing.png\n");
   CliResult r = run("m.obj --size 32x32 -o out.png");
   ASSERT_EQ(r.exit_code, 0) << r.err;

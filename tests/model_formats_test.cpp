@@ -52,7 +52,9 @@ std::string num(float v) {
   return buffer;
 }
 
-std::string vec(const glm::vec3& v) { return num(v.x) + " " + num(v.y) + " " + num(v.z); }
+std::string vec(const glm::vec3& v) {
+  return num(v.x) + " " + num(v.y) + " " + num(v.z);
+}
 
 std::string obj_text() {
   std::string s = "# box\n";
@@ -73,10 +75,12 @@ std::string ply_header(const char* format, const char* normal_type, const char* 
   return std::string("ply\nformat ") + format +
          " 1.0\ncomment written by softrast's tests\nelement vertex 24\n"
          "property float x\nproperty float y\nproperty float z\n"
-         "property " + normal_type + " nx\nproperty " + normal_type + " ny\nproperty " +
-         normal_type + " nz\n"
+         "property " +
+         normal_type + " nx\nproperty " + normal_type + " ny\nproperty " + normal_type +
+         " nz\n"
          "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-         "element face 6\nproperty list " + list + "\nend_header\n";
+         "element face 6\nproperty list " +
+         list + "\nend_header\n";
 }
 
 std::string ply_ascii() {
@@ -199,8 +203,10 @@ struct Encoded {
 };
 
 std::vector<Encoded> encodings() {
-  return {{"ascii.ply", ply_ascii()},   {"little.ply", ply_binary(false)},
-          {"big.ply", ply_binary(true)}, {"ascii.stl", stl_ascii()},
+  return {{"ascii.ply", ply_ascii()},
+          {"little.ply", ply_binary(false)},
+          {"big.ply", ply_binary(true)},
+          {"ascii.stl", stl_ascii()},
           {"binary.stl", stl_binary()}};
 }
 
@@ -241,16 +247,17 @@ TEST_F(ModelFormatsTest, EveryTruncationIsAClearError) {
 }
 
 TEST_F(ModelFormatsTest, MessagesNameTheFileAndPlace) {
-  std::string p = write("a.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
-                                 "property float y\nproperty float z\nelement face 1\n"
-                                 "property list uchar int vertex_indices\nend_header\n"
-                                 "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+  std::string p = write("a.ply",
+                        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                        "property float y\nproperty float z\nelement face 1\n"
+                        "property list uchar int vertex_indices\nend_header\n"
+                        "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
   Result<Mesh> mesh = load_model(p);
   ASSERT_FALSE(mesh.ok());
-  EXPECT_EQ(mesh.status().message(),
-            p + ":13: face 0: vertex index 7 is out of range (0..2)");
-  p = write("b.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\n"
-                     "property float x\nproperty float y\nproperty float z\nend_header\n");
+  EXPECT_EQ(mesh.status().message(), p + ":13: face 0: vertex index 7 is out of range (0..2)");
+  p = write("b.ply",
+            "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\n"
+            "property float x\nproperty float y\nproperty float z\nend_header\n");
   mesh = load_model(p);
   ASSERT_FALSE(mesh.ok());
   EXPECT_EQ(mesh.status().message(),
@@ -266,8 +273,9 @@ TEST_F(ModelFormatsTest, MessagesNameTheFileAndPlace) {
   ASSERT_FALSE(mesh.ok());
   EXPECT_EQ(mesh.status().message(),
             p + ": binary STL declares 12 triangles (684 bytes) but has 674 bytes (truncated)");
-  p = write("e.stl", "solid x\n facet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n"
-                     " endloop\n endfacet\nendsolid x\n");
+  p = write("e.stl",
+            "solid x\n facet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n"
+            " endloop\n endfacet\nendsolid x\n");
   mesh = load_model(p);
   ASSERT_FALSE(mesh.ok());
   EXPECT_EQ(mesh.status().message(), p + ":6: expected 'vertex', found 'endloop'");
@@ -283,17 +291,20 @@ TEST_F(ModelFormatsTest, FilesThatAreNotModelsSayWhatTheyAre) {
   write("models.zip", std::string("PK\x03\x04", 4) + std::string(26, '\0'));
   write("paper.pdf", "%PDF-1.7\n");
   const std::pair<const char*, const char*> cases[] = {
-      {"tex.png", "a PNG image"},      {"tex.jpg", "a JPEG image"},
-      {"tex.tga", "a TGA image"},      {"scene.gltf", "a glTF scene (JSON)"},
-      {"scene.glb", "a binary glTF (GLB) scene"}, {"models.zip", "a ZIP archive"},
+      {"tex.png", "a PNG image"},
+      {"tex.jpg", "a JPEG image"},
+      {"tex.tga", "a TGA image"},
+      {"scene.gltf", "a glTF scene (JSON)"},
+      {"scene.glb", "a binary glTF (GLB) scene"},
+      {"models.zip", "a ZIP archive"},
       {"paper.pdf", "a PDF document"},
   };
   for (auto [name, what] : cases) {
     std::string path = (dir_ / name).string();
     Result<Mesh> mesh = load_model(path);
     ASSERT_FALSE(mesh.ok()) << name;
-    EXPECT_EQ(mesh.status().message(), path + ": this is " + what +
-                                           ", not a model (softrast reads OBJ, PLY and STL)");
+    EXPECT_EQ(mesh.status().message(),
+              path + ": this is " + what + ", not a model (softrast reads OBJ, PLY and STL)");
   }
 }
 
@@ -319,10 +330,18 @@ TEST_F(ModelFormatsTest, MutatedFilesLoadOrFailCleanly) {
       for (int k = 0; k < edits; ++k) {
         size_t at = next(uint32_t(bytes.size()));
         switch (next(4)) {
-          case 0: bytes[at] = char(next(256)); break;
-          case 1: bytes[at] ^= char(1 << next(8)); break;
-          case 2: bytes.replace(at, std::min<size_t>(4, bytes.size() - at), "\xff\xff\xff\x7f", 4); break;
-          case 3: bytes.insert(at, e.bytes.substr(next(uint32_t(e.bytes.size())), next(64))); break;
+          case 0:
+            bytes[at] = char(next(256));
+            break;
+          case 1:
+            bytes[at] ^= char(1 << next(8));
+            break;
+          case 2:
+            bytes.replace(at, std::min<size_t>(4, bytes.size() - at), "\xff\xff\xff\x7f", 4);
+            break;
+          case 3:
+            bytes.insert(at, e.bytes.substr(next(uint32_t(e.bytes.size())), next(64)));
+            break;
         }
       }
       std::string path = write(e.name, bytes);

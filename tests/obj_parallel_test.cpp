@@ -120,8 +120,8 @@ TEST_F(ObjParallelTest, ErrorsDeepInTheFileNameTheirLine) {
   write("e.obj", strip.text + "f 1 2\n" + strip.text + "v x\n");
   mesh = load_obj(path("e.obj"));
   ASSERT_FALSE(mesh.ok());
-  EXPECT_EQ(mesh.status().message(), path("e.obj") + ":" + std::to_string(bad_line) +
-                                         ": face with fewer than 3 vertices");
+  EXPECT_EQ(mesh.status().message(),
+            path("e.obj") + ":" + std::to_string(bad_line) + ": face with fewer than 3 vertices");
 }
 
 TEST_F(ObjParallelTest, FacesBeforeTheirVerticesAcrossPieces) {

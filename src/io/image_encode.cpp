@@ -189,8 +189,8 @@ Result<std::vector<uint8_t>> encode_png(const Image& image) {
   ihdr[5] = uint8_t(image.height >> 16);
   ihdr[6] = uint8_t(image.height >> 8);
   ihdr[7] = uint8_t(image.height);
-  ihdr[8] = 8;               // bits per channel
-  ihdr[9] = rgb ? 2 : 6;     // truecolour, with alpha or not
+  ihdr[8] = 8;            // bits per channel
+  ihdr[9] = rgb ? 2 : 6;  // truecolour, with alpha or not
   std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   png.reserve(idat.size() + 64);
   put_chunk(png, "IHDR", ihdr, sizeof ihdr);

@@ -43,7 +43,9 @@ constexpr std::array<Signature, 10> kNotModels = {{
     {"PK\x03\x04", "a ZIP archive"},
     {"%PDF", "a PDF document"},
     {"\x1f\x8b", "a gzip-compressed file"},
-    {"\x7f" "ELF", "a program (ELF)"},
+    {"\x7f"
+     "ELF",
+     "a program (ELF)"},
     {"Kaydara FBX Binary", "an FBX scene"},
     {"BM", "a BMP image"},
 }};
@@ -145,7 +147,9 @@ Status read_whole_file(const std::string& path, int64_t max_bytes, const char* k
 
 }  // namespace detail
 
-Result<Mesh> load_ply(const std::string& path) { return load_whole(path, Kind::kPly); }
+Result<Mesh> load_ply(const std::string& path) {
+  return load_whole(path, Kind::kPly);
+}
 
 Result<Mesh> load_stl(const std::string& path) {
   std::vector<char> bytes;
@@ -169,8 +173,8 @@ Result<Mesh> load_model(const std::string& path) {
   }
   if (starts_solid(head)) return load_whole(path, Kind::kAsciiStl);
   if (const char* what = not_a_model(head)) {
-    return fail(path, std::string("this is ") + what +
-                          ", not a model (softrast reads OBJ, PLY and STL)");
+    return fail(path,
+                std::string("this is ") + what + ", not a model (softrast reads OBJ, PLY and STL)");
   }
   std::string ext = lowercase_extension(path);
   if (ext == ".stl") return load_stl(path);  // says why it is not one

@@ -33,7 +33,8 @@ Status fail_at(const std::string& path, size_t line, const std::string& reason) 
 // (it parses prefixes); nine stay below 2^31 / 10, and a sane file never has more than three.
 bool mtl_number_out_of_range(std::string_view word) {
   float ignored = 0.0f;
-  if (parse_obj_float(word, ignored) == ObjNumber::kOutOfRange && word.find_first_of("nN") == word.npos) {
+  if (parse_obj_float(word, ignored) == ObjNumber::kOutOfRange &&
+      word.find_first_of("nN") == word.npos) {
     return true;  // inf and nan are words tinyobj does not parse as numbers
   }
   size_t e = word.find_first_of("eE");
@@ -71,13 +72,13 @@ std::vector<bool> scan_kd(const std::string& text) {
 }  // namespace
 
 Status ObjMaterials::load_library(const std::string& name, const std::string& obj_path,
-                                size_t obj_line) {
+                                  size_t obj_line) {
   if (!loaded_.insert(name).second) return {};
   fs::path path = obj_dir_ / name;
   std::error_code ignored;
   if (!fs::exists(path, ignored)) {
-    warnings_.push_back(obj_path + ":" + std::to_string(obj_line) + ": material library '" +
-                        name + "' not found; its materials get the default colour");
+    warnings_.push_back(obj_path + ":" + std::to_string(obj_line) + ": material library '" + name +
+                        "' not found; its materials get the default colour");
     return {};
   }
   std::string text;
@@ -86,8 +87,7 @@ Status ObjMaterials::load_library(const std::string& name, const std::string& ob
         ObjWords words(line);
         for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
           if (mtl_number_out_of_range(w)) {
-            return fail_at(path.string(), number,
-                           "number " + std::string(w) + " is out of range");
+            return fail_at(path.string(), number, "number " + std::string(w) + " is out of range");
           }
         }
         text.append(line);
@@ -143,9 +143,8 @@ Result<std::vector<Material>> ObjMaterials::convert(const std::string& path,
       if (texture.ok()) {
         material.diffuse_map = *texture;
       } else {
-        warnings.push_back(path + ": material '" + source.name +
-                           "': map_Kd: " + texture.status().message() +
-                           "; drawn without this texture");
+        warnings.push_back(path + ": material '" + source.name + "': map_Kd: " +
+                           texture.status().message() + "; drawn without this texture");
       }
     }
     materials.push_back(std::move(material));

@@ -104,7 +104,9 @@ class ChunkedValues {
     }
   }
   size_t count() const { return count_; }
-  const float* at(size_t i) const { return chunks_[i >> kShift].data() + (i & kMask) * components_; }
+  const float* at(size_t i) const {
+    return chunks_[i >> kShift].data() + (i & kMask) * components_;
+  }
   void release() { chunks_ = {}; }
 
  private:
@@ -201,7 +203,9 @@ glm::vec3 unit_or_z(const glm::dvec3& n) {
 // indices are joined; each call takes well under a millisecond.
 constexpr size_t kTrimEvery = 8;
 
-void return_free_memory() { malloc_trim(0); }
+void return_free_memory() {
+  malloc_trim(0);
+}
 
 // Merges parsed pieces in file order into the mesh, then finishes it.
 class ObjMerge {

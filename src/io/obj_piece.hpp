@@ -21,7 +21,9 @@ inline constexpr size_t kObjComponents[3] = {3, 2, 3};  // floats stored per ele
 // A corner's index into one array: >= 0 is a 0-based index in the whole file; kObjAbsent means
 // no uv or normal; any other negative value -(1 + i) is element i of this piece's own elements.
 inline constexpr int32_t kObjAbsent = std::numeric_limits<int32_t>::min();
-inline int32_t obj_local(size_t i) { return -1 - int32_t(i); }
+inline int32_t obj_local(size_t i) {
+  return -1 - int32_t(i);
+}
 
 struct ObjCorner {
   int32_t index[3];  // by ObjAttr
@@ -69,11 +71,11 @@ struct ObjPiece {
   bool parsed = false;     // set by the parsing thread under the workers' lock
   size_t lines = 0;        // lines parsed (up to and including an error's line)
   std::vector<float> values[3];
-  std::vector<ObjCorner> corners;     // every face's corners in order
-  std::vector<uint32_t> face_sizes;   // corners per face
-  size_t triangles = 0;               // sum of face_sizes[i] - 2
-  std::vector<ObjFixup> fixups;       // in line order
-  std::vector<ObjEvent> events;       // in line order
+  std::vector<ObjCorner> corners;    // every face's corners in order
+  std::vector<uint32_t> face_sizes;  // corners per face
+  size_t triangles = 0;              // sum of face_sizes[i] - 2
+  std::vector<ObjFixup> fixups;      // in line order
+  std::vector<ObjEvent> events;      // in line order
   ObjLargest largest[3];
   std::optional<ObjPieceError> error;
 };
@@ -106,7 +108,9 @@ class ObjWords {
   }
 
  private:
-  static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+  static bool is_space(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+  }
   const char* at_;
   const char* end_;
 };

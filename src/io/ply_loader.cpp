@@ -39,11 +39,21 @@ struct TypeName {
   Type type;
 };
 constexpr std::array<TypeName, 16> kTypeNames = {{
-    {"char", Type::kInt8},     {"int8", Type::kInt8},       {"uchar", Type::kUint8},
-    {"uint8", Type::kUint8},   {"short", Type::kInt16},     {"int16", Type::kInt16},
-    {"ushort", Type::kUint16}, {"uint16", Type::kUint16},   {"int", Type::kInt32},
-    {"int32", Type::kInt32},   {"uint", Type::kUint32},     {"uint32", Type::kUint32},
-    {"float", Type::kFloat32}, {"float32", Type::kFloat32}, {"double", Type::kFloat64},
+    {"char", Type::kInt8},
+    {"int8", Type::kInt8},
+    {"uchar", Type::kUint8},
+    {"uint8", Type::kUint8},
+    {"short", Type::kInt16},
+    {"int16", Type::kInt16},
+    {"ushort", Type::kUint16},
+    {"uint16", Type::kUint16},
+    {"int", Type::kInt32},
+    {"int32", Type::kInt32},
+    {"uint", Type::kUint32},
+    {"uint32", Type::kUint32},
+    {"float", Type::kFloat32},
+    {"float32", Type::kFloat32},
+    {"double", Type::kFloat64},
     {"float64", Type::kFloat64},
 }};
 
@@ -65,7 +75,9 @@ size_t type_size(Type t) {
   return 8;
 }
 
-bool is_integer(Type t) { return t != Type::kFloat32 && t != Type::kFloat64; }
+bool is_integer(Type t) {
+  return t != Type::kFloat32 && t != Type::kFloat64;
+}
 
 std::optional<Type> type_named(std::string_view name) {
   for (const TypeName& t : kTypeNames) {
@@ -168,7 +180,8 @@ class HeaderParser {
 
 Status HeaderParser::format_line(const std::vector<std::string_view>& w, Header& h) {
   if (has_format_) return error("a second 'format' line");
-  if (w.size() != 3 || w[2] != "1.0") return error("expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
+  if (w.size() != 3 || w[2] != "1.0")
+    return error("expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
   if (w[1] == "ascii") {
     h.encoding = Encoding::kAscii;
   } else if (w[1] == "binary_little_endian") {
@@ -206,7 +219,8 @@ Status HeaderParser::property_line(const std::vector<std::string_view>& w, Heade
   if (w.size() >= 2 && w[1] == "list") {
     if (w.size() != 5) return error("expected 'property list COUNT_TYPE ITEM_TYPE NAME'");
     std::optional<Type> count = type_named(w[2]), item = type_named(w[3]);
-    if (!count || !item) return error("unknown type in '" + std::string(w[2]) + " " + std::string(w[3]) + "'");
+    if (!count || !item)
+      return error("unknown type in '" + std::string(w[2]) + " " + std::string(w[3]) + "'");
     if (!is_integer(*count)) return error("a list count must be an integer type");
     p.list = true;
     p.count_type = *count;
@@ -276,7 +290,11 @@ Status HeaderParser::parse(Header& h) {
 class BodyReader {
  public:
   BodyReader(const char* data, size_t size, const Header& h, const std::string& name)
-      : data_(data), size_(size), at_(h.data_start), encoding_(h.encoding), line_(h.lines + 1),
+      : data_(data),
+        size_(size),
+        at_(h.data_start),
+        encoding_(h.encoding),
+        line_(h.lines + 1),
         name_(name) {}
 
   size_t remaining() const { return size_ - at_; }
@@ -329,14 +347,46 @@ class BodyReader {
     if (encoding_ == Encoding::kBig) std::reverse(b, b + n);
     at_ += n;
     switch (t) {
-      case Type::kInt8: value = double(int8_t(b[0])); break;
-      case Type::kUint8: value = double(b[0]); break;
-      case Type::kInt16: { int16_t v; std::memcpy(&v, b, 2); value = v; break; }
-      case Type::kUint16: { uint16_t v; std::memcpy(&v, b, 2); value = v; break; }
-      case Type::kInt32: { int32_t v; std::memcpy(&v, b, 4); value = v; break; }
-      case Type::kUint32: { uint32_t v; std::memcpy(&v, b, 4); value = v; break; }
-      case Type::kFloat32: { float v; std::memcpy(&v, b, 4); value = v; break; }
-      case Type::kFloat64: { std::memcpy(&value, b, 8); break; }
+      case Type::kInt8:
+        value = double(int8_t(b[0]));
+        break;
+      case Type::kUint8:
+        value = double(b[0]);
+        break;
+      case Type::kInt16: {
+        int16_t v;
+        std::memcpy(&v, b, 2);
+        value = v;
+        break;
+      }
+      case Type::kUint16: {
+        uint16_t v;
+        std::memcpy(&v, b, 2);
+        value = v;
+        break;
+      }
+      case Type::kInt32: {
+        int32_t v;
+        std::memcpy(&v, b, 4);
+        value = v;
+        break;
+      }
+      case Type::kUint32: {
+        uint32_t v;
+        std::memcpy(&v, b, 4);
+        value = v;
+        break;
+      }
+      case Type::kFloat32: {
+        float v;
+        std::memcpy(&v, b, 4);
+        value = v;
+        break;
+      }
+      case Type::kFloat64: {
+        std::memcpy(&value, b, 8);
+        break;
+      }
     }
     return true;
   }
@@ -351,7 +401,8 @@ class BodyReader {
     std::string_view word(data_ + start, at_ - start);
     if (is_integer(t)) return parse_integer(word, t, value);
     auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), value);
-    if (ec == std::errc::result_out_of_range) return fail("number " + std::string(word) + " is out of range");
+    if (ec == std::errc::result_out_of_range)
+      return fail("number " + std::string(word) + " is out of range");
     if (ec != std::errc() || end != word.data() + word.size()) {
       return fail(quoted(word) + " is not a number");
     }
@@ -367,12 +418,27 @@ class BodyReader {
     if (end != word.data() + word.size()) return fail(quoted(word) + " is not an integer");
     int64_t lo = 0, hi = 0;
     switch (t) {
-      case Type::kInt8: lo = INT8_MIN; hi = INT8_MAX; break;
-      case Type::kUint8: hi = UINT8_MAX; break;
-      case Type::kInt16: lo = INT16_MIN; hi = INT16_MAX; break;
-      case Type::kUint16: hi = UINT16_MAX; break;
-      case Type::kInt32: lo = INT32_MIN; hi = INT32_MAX; break;
-      default: hi = UINT32_MAX; break;
+      case Type::kInt8:
+        lo = INT8_MIN;
+        hi = INT8_MAX;
+        break;
+      case Type::kUint8:
+        hi = UINT8_MAX;
+        break;
+      case Type::kInt16:
+        lo = INT16_MIN;
+        hi = INT16_MAX;
+        break;
+      case Type::kUint16:
+        hi = UINT16_MAX;
+        break;
+      case Type::kInt32:
+        lo = INT32_MIN;
+        hi = INT32_MAX;
+        break;
+      default:
+        hi = UINT32_MAX;
+        break;
     }
     if (ec == std::errc::result_out_of_range || v < lo || v > hi) {
       return fail("integer " + std::string(word) + " does not fit its type");
@@ -431,7 +497,8 @@ bool PlyBuilder::read_vertex(const Element& e, size_t index) {
     if (p.list) {
       double count = 0.0;
       if (!body_.read(p.count_type, count)) return false;
-      if (count < 0 || count > double(kMaxListLength)) return body_.fail("list length out of range");
+      if (count < 0 || count > double(kMaxListLength))
+        return body_.fail("list length out of range");
       for (int k = 0; k < int(count); ++k) {
         if (!body_.read(p.type, value)) return false;
       }
@@ -445,7 +512,8 @@ bool PlyBuilder::read_vertex(const Element& e, size_t index) {
     v[int(p.role)] = float(value);
   }
   mesh_.positions[index] = {v[int(Role::kX)], v[int(Role::kY)], v[int(Role::kZ)]};
-  if (has_normals_) mesh_.normals[index] = {v[int(Role::kNx)], v[int(Role::kNy)], v[int(Role::kNz)]};
+  if (has_normals_)
+    mesh_.normals[index] = {v[int(Role::kNx)], v[int(Role::kNy)], v[int(Role::kNz)]};
   if (has_uvs_) mesh_.uvs[index] = {v[int(Role::kU)], v[int(Role::kV)]};
   return true;
 }
@@ -478,8 +546,9 @@ bool PlyBuilder::read_face(const Element& e, const Property& indices, size_t fac
     for (int k = 0; k < int(count); ++k) {
       if (!body_.read(p.type, value)) return false;
       if (value < 0 || value >= double(vertex_count_)) {
-        return body_.fail("vertex index " + std::to_string(int64_t(value)) + " is out of range (0.." +
-                          std::to_string(int64_t(vertex_count_) - 1) + ")");
+        return body_.fail("vertex index " + std::to_string(int64_t(value)) +
+                          " is out of range (0.." + std::to_string(int64_t(vertex_count_) - 1) +
+                          ")");
       }
       corners_.push_back(uint32_t(value));
     }
@@ -506,7 +575,7 @@ Status PlyBuilder::read_element(const Element& e) {
   }
   if (e.name == "face" && indices) mesh_.indices.reserve(size_t(e.count) * 3);
   for (uint64_t i = 0; i < e.count; ++i) {
-    bool ok = e.name == "vertex"       ? read_vertex(e, size_t(i))
+    bool ok = e.name == "vertex"            ? read_vertex(e, size_t(i))
               : e.name == "face" && indices ? read_face(e, *indices, size_t(i))
                                             : read_face(e, Property{}, size_t(i));
     if (!ok || !body_.end_element()) return where(e, i);

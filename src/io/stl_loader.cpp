@@ -47,7 +47,9 @@ float little_float(const char* p) {
   return f;
 }
 
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 // Appends one flat triangle; the normal is the facet's if usable, else the triangle's.
 void add_triangle(Mesh& mesh, const glm::vec3 p[3], glm::vec3 normal) {
@@ -148,7 +150,8 @@ class AsciiStl {
   Status expect(std::string_view keyword) {
     std::string_view w = words_.next();
     if (w == keyword) return {};
-    if (w.empty()) return error("the file ends where '" + std::string(keyword) + "' should be (truncated)");
+    if (w.empty())
+      return error("the file ends where '" + std::string(keyword) + "' should be (truncated)");
     return error("expected '" + std::string(keyword) + "', found '" + printable(w) + "'");
   }
   static std::string printable(std::string_view w) {
@@ -212,7 +215,8 @@ Result<Mesh> AsciiStl::parse() {
       words_.skip_line();
       std::string_view after = words_.next();
       if (after.empty()) break;
-      if (after != "solid") return error("expected 'solid' or the end, found '" + printable(after) + "'");
+      if (after != "solid")
+        return error("expected 'solid' or the end, found '" + printable(after) + "'");
       words_.skip_line();
     } else if (w.empty()) {
       return error("the file ends before 'endsolid' (truncated)");
