@@ -627,6 +627,7 @@ Result<Mesh> PlyBuilder::build() {
 }  // namespace
 
 Result<Mesh> parse_ply(const char* data, size_t size, const std::string& name) {
+  if (size == 0) data = "";  // an empty vector's data() may be null, which memchr must not get
   Header header;
   if (Status s = HeaderParser(data, size, name).parse(header); !s.ok()) return s;
   BodyReader body(data, size, header, name);

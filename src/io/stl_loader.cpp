@@ -235,6 +235,7 @@ bool is_binary_stl(const char* data, size_t size) {
 }
 
 Result<Mesh> parse_stl(const char* data, size_t size, bool binary, const std::string& name) {
+  if (size == 0) data = "";  // an empty vector's data() may be null, which memchr must not get
   if (binary) return parse_binary(data, size, name);
   return AsciiStl(data, size, name).parse();
 }
