@@ -5,10 +5,10 @@ packages=(
   cmake g++ make pkg-config  # the toolchain
   libglm-dev                 # vectors and matrices with OpenGL's conventions
   libtinyobjloader-dev       # OBJ parsing
-  libstb-dev                 # PNG/TGA encoding (stb_image_write); the reference tools' reading
+  libstb-dev                 # TGA encoding (stb_image_write); the reference tools' reading
   libspng-dev                # PNG decoding: fuzzed upstream, size limits before allocation
-  libjpeg62-turbo-dev        # JPEG decoding: fuzzed upstream, size known before allocation
-  zlib1g-dev                 # crc32 for the PNG chunks the decoder tests build byte by byte
+  libjpeg62-turbo-dev        # JPEG decoding (size known before allocation) and JPEG writing
+  zlib1g-dev                 # PNG writing (level 1, strips compressed in parallel); test PNGs
   libcli11-dev               # the command line
   nlohmann-json3-dev         # JSON: batch job lines, --json records (header-only)
   libgtest-dev               # the test suite

@@ -501,7 +501,7 @@ TEST_F(CliTest, EmptyFolderIsAnError) {
   write("nothing/notes.txt", "no models here\n");
   CliRun r = run("nothing -o out.png");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(r.err, "softrast: error: nothing: no model files (.obj) in this folder\n");
+  EXPECT_EQ(r.err, "softrast: error: nothing: no model files (.obj, .ply, .stl) in this folder\n");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -658,7 +658,7 @@ const BadInput kBadInputs[] = {
     {"OutputExtensionBmp", "-o out.bmp"},
     {"OutputNoExtension", "-o out"},
     {"OutputIsAFolder", "-o ."},
-    {"OutputExtensionWithModel", "quad.obj -o out.jpg"},
+    {"OutputExtensionWithModel", "quad.obj -o out.gif"},
     {"FramesWithBadOutput", "--frames 2 -o /nonexistent/dir/out.png"},
 };
 

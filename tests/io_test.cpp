@@ -194,7 +194,7 @@ TEST_F(IoTest, SaveToMissingFolderFailsAndWritesNothing) {
 }
 
 TEST_F(IoTest, SaveWithUnknownExtensionFails) {
-  EXPECT_FALSE(save_image(path("a.jpg"), pattern(2, 2)).ok());
+  EXPECT_FALSE(save_image(path("a.bmp"), pattern(2, 2)).ok());
   EXPECT_FALSE(save_image(path("a"), pattern(2, 2)).ok());
   EXPECT_TRUE(files().empty());
 }
@@ -660,18 +660,29 @@ TEST_F(IoTest, ObjMissingFileIsAnError) {
   EXPECT_FALSE(load_obj(dir_.string()).ok());  // a folder
 }
 
-TEST_F(IoTest, ObjWithGarbageTextureIsAnErrorNamingIt) {
+// A texture the model refers to that cannot be loaded is a warning: the material is drawn
+// without it (a texture named on the command line is still an error, in the CLI).
+TEST_F(IoTest, ObjWithGarbageOrMissingTextureWarnsAndLoads) {
   write("bad.png", "not a png at all, not even close");
-  write("g.mtl", "newmtl m\nmap_Kd bad.png\n");
+  write("g.mtl", "newmtl m\nKd 0.5 0.5 0.5\nmap_Kd bad.png\n");
   write("g.obj", std::string("mtllib g.mtl\n") + kQuadPositions + "usemtl m\nf 1 2 3\n");
   Result<Mesh> mesh = load_obj(path("g.obj"));
-  ASSERT_FALSE(mesh.ok());
-  EXPECT_NE(mesh.status().message().find("bad.png"), std::string::npos) << mesh.status().message();
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  ASSERT_EQ(mesh->materials.size(), 1u);
+  EXPECT_EQ(mesh->materials[0].diffuse_map, nullptr);
+  EXPECT_EQ(mesh->materials[0].diffuse, glm::vec3(0.5f));
+  ASSERT_EQ(mesh->warnings.size(), 1u);
+  EXPECT_EQ(mesh->warnings[0],
+            path("g.obj") + ": material 'm': map_Kd: " + path("bad.png") +
+                ": unsupported image format (PNG, TGA and JPG are supported); drawn without this "
+                "texture");
   write("g.mtl", "newmtl m\nmap_Kd absent.png\n");
   mesh = load_obj(path("g.obj"));
-  ASSERT_FALSE(mesh.ok());
-  EXPECT_NE(mesh.status().message().find("absent.png"), std::string::npos)
-      << mesh.status().message();
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  ASSERT_EQ(mesh->warnings.size(), 1u);
+  EXPECT_EQ(mesh->warnings[0], path("g.obj") + ": material 'm': map_Kd: " + path("absent.png") +
+                                   ": cannot open: No such file or directory; drawn without this "
+                                   "texture");
 }
 
 TEST_F(IoTest, ObjWithMissingMtlLoadsWithoutMaterials) {
@@ -681,6 +692,10 @@ TEST_F(IoTest, ObjWithMissingMtlLoadsWithoutMaterials) {
   EXPECT_TRUE(mesh->materials.empty());
   ASSERT_EQ(mesh->submeshes.size(), 1u);
   EXPECT_EQ(mesh->submeshes[0].material, -1);
+  ASSERT_EQ(mesh->warnings.size(), 1u);
+  EXPECT_EQ(mesh->warnings[0], path("n.obj") +
+                                   ":1: material library 'nowhere.mtl' not found; its materials "
+                                   "get the default colour");
 }
 
 TEST(ObjSharedModels, AfricanHead) {

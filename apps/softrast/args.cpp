@@ -10,12 +10,14 @@ namespace {
 
 void define_output_flags(CLI::App& app, RawArgs& a) {
   app.add_option("MODEL", a.models,
-                 "Model files (Wavefront OBJ, with the MTL files they name) or folders of them; "
+                 "Model files (Wavefront OBJ with the MTL files it names, PLY or STL, told by their contents) or "
+                 "folders of them; "
                  "several are drawn together as one scene, each with its own materials. Without "
                  "MODEL, the built-in demo scene")
       ->type_name("MODEL...");
   app.add_option("-o,--out", a.output,
-                 "Output image, .png or .tga (default softrast.png; with --frames, only if given)")
+                 "Output image, .png, .jpg or .tga, or - for PNG on the standard output (default "
+                 "softrast.png; with --frames, only if given)")
       ->type_name("PATH");
   app.add_option("--size", a.size, "Image size (default 800x600)")->type_name("WxH");
   app.add_option("--frames", a.frames,
@@ -135,6 +137,9 @@ void define_render_flags(CLI::App& app, RawArgs& args) {
   define_camera_flags(app, args);
   define_shading_flags(app, args);
   define_state_flags(app, args);
+  // Image output (io): JPEG quality.
+  app.add_option("--quality", args.quality, "JPEG quality for .jpg output, 1..100 (default 90)")
+      ->type_name("Q");
 }
 
 }  // namespace softrast::cli

@@ -43,6 +43,7 @@ struct RawArgs {
   // Set by define_sequence_flags (sequence.hpp) for `softrast render` only, never in batch jobs.
   std::optional<int> turntable;
   bool json = false;
+  std::optional<int> quality;  // JPEG output quality, 1..100
 };
 
 // Adds every flag of the render command to `app`, storing into `args`.

@@ -179,7 +179,7 @@ struct Batch {
   const BatchArgs& args;
   std::string name;                          // the jobs file in messages
   std::map<std::string, size_t> first_line;  // output (normal path) -> first line writing it
-  FileCache<Mesh> models{kModelCacheBytes, load_obj, mesh_bytes};
+  FileCache<Mesh> models{kModelCacheBytes, load_model, mesh_bytes};
   FileCache<TexturePtr> textures{kTextureCacheBytes, read_texture, texture_bytes};
 };
 

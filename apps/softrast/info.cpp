@@ -168,8 +168,9 @@ ojson geometry_json(const Mesh& mesh) {
 // Everything known about one model; "error" when it does not load.
 ojson describe(const std::string& path) {
   ojson info = {{"model", path}};
-  Result<Mesh> mesh = load_obj(path);
+  Result<Mesh> mesh = load_model(path);
   if (!mesh) info["error"] = mesh.status().message();
+  if (mesh && !mesh->warnings.empty()) info["warnings"] = mesh->warnings;  // e.g. a missing map
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) return info;
   Scan scan = scan_model(path);
@@ -262,6 +263,11 @@ int info_command(const InfoArgs& args) {
     if (info.contains("error")) {
       print_error(info["error"].get<std::string>());
       all_loaded = false;
+    }
+    if (info.contains("warnings")) {
+      for (const ojson& w : info["warnings"]) {
+        std::fprintf(stderr, "softrast: warning: %s\n", w.get<std::string>().c_str());
+      }
     }
     if (args.json) {
       if (!print_line(info.dump(-1, ' ', false, ojson::error_handler_t::replace))) {

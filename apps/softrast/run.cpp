@@ -114,9 +114,21 @@ Status benchmark(Job& job) {
   return {};
 }
 
+// "-o -": the PNG bytes go straight to the standard output, no temporary file.
+Status write_to_stdout(const Image& image) {
+  Result<std::vector<uint8_t>> png = encode_image(image, ImageFormat::kPng);
+  if (!png) return Status::error("standard output: " + png.status().message());
+  if (std::fwrite(png->data(), 1, png->size(), stdout) != png->size() || std::fflush(stdout) != 0) {
+    return Status::error("cannot write the image to the standard output");
+  }
+  return {};
+}
+
 Status write_image(const Job& job) {
-  Status s = save_image(*job.output, job.framebuffer.to_image());
-  if (s.ok()) progress(job, "wrote " + *job.output);
+  bool to_stdout = *job.output == "-";
+  Status s = to_stdout ? write_to_stdout(job.framebuffer.to_image())
+                       : save_image(*job.output, job.framebuffer.to_image(), job.jpeg_quality);
+  if (s.ok()) progress(job, "wrote " + (to_stdout ? std::string("standard output") : *job.output));
   return s;
 }
 

@@ -14,12 +14,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The extensions a folder's model files have (compared in lower case).
-// TODO(lead, merging the io branch): add ".ply" and ".stl" here and call its load_model() (which
-// tells the formats apart by content) instead of load_obj() in load_models(); its Mesh::warnings
-// then reach Scene::warnings through take_loader_warnings(), so the io branch's own printing of
-// them in setup.cpp's load_scene() goes.
-constexpr std::array<std::string_view, 1> kModelExtensions = {".obj"};
+// The extensions a folder's model files have (compared in lower case); each file is then read by
+// load_model(), which tells the formats apart by content.
+constexpr std::array<std::string_view, 3> kModelExtensions = {".obj", ".ply", ".stl"};
 
 std::string lowercase(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(),
@@ -118,7 +115,7 @@ Status append_mesh(Mesh& scene, const Mesh& part) {
 Result<LoadedModels> load_models(const std::vector<std::string>& paths, const ModelLoader& load) {
   LoadedModels loaded;
   for (const std::string& path : paths) {
-    Result<Mesh> mesh = load ? load(path) : load_obj(path);
+    Result<Mesh> mesh = load ? load(path) : load_model(path);
     if (!mesh) return mesh.status();
     take_loader_warnings(*mesh, loaded.warnings);
     loaded.parts.push_back({path, has_varying_uvs(*mesh), has_maps(*mesh)});

@@ -14,6 +14,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -96,13 +97,6 @@ Result<ShaderKind> shader_named(const std::string& name) {
 
 bool in_unit_range(float x) {
   return x >= 0.0f && x <= 1.0f;
-}
-
-std::string lowercase_extension(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
 }
 
 constexpr int kMaxThreads = 1024;
@@ -224,6 +218,25 @@ void interpret_camera(const RawArgs& a, CameraFlags& c, FirstError& e) {
   interpret_placement(a, c, e);
 }
 
+// The output's format: .png, .jpg/.jpeg, .tga, or "-" (PNG on the standard output); --quality.
+void interpret_image_output(const RawArgs& a, JobSpec& spec, FirstError& e) {
+  bool to_stdout = spec.output && *spec.output == "-";
+  std::optional<ImageFormat> format;
+  if (spec.output && !to_stdout) {
+    format = image_format_of(*spec.output);
+    e.fail_if(!format, *spec.output +
+                           ": unknown image format (the output must end in .png, .jpg or .tga, "
+                           "or be - for the standard output)");
+  }
+  e.fail_if(to_stdout && spec.frames > 0,
+            "-o -: cannot be combined with --frames (both write to the standard output)");
+  if (a.quality) {
+    e.fail_if(*a.quality < 1 || *a.quality > 100, "--quality: must be in 1..100");
+    e.fail_if(format != ImageFormat::kJpeg, "--quality: only for .jpg output");
+    spec.jpeg_quality = *a.quality;
+  }
+}
+
 void interpret_output(const RawArgs& a, JobSpec& spec, FirstError& e) {
   if (a.size) {
     glm::ivec2 size(0);
@@ -239,11 +252,7 @@ void interpret_output(const RawArgs& a, JobSpec& spec, FirstError& e) {
   if (a.background) e.take(parse_color("--background", *a.background, true), spec.background);
   spec.output = a.output;
   if (!spec.output && spec.frames == 0) spec.output = "softrast.png";
-  if (spec.output) {
-    std::string ext = lowercase_extension(*spec.output);
-    e.fail_if(ext != ".png" && ext != ".tga",
-              *spec.output + ": unknown image format (the output must end in .png or .tga)");
-  }
+  interpret_image_output(a, spec, e);
 }
 
 // The folder must exist and be writable now, not after a long render.
@@ -347,7 +356,10 @@ Result<JobSpec> interpret(const RawArgs& args) {
 }
 
 Result<Job> prepare(const JobSpec& spec, const Loaders& loaders) {
-  if (spec.output) {
+  if (spec.output && *spec.output == "-" && ::isatty(STDOUT_FILENO)) {
+    return Status::error("-o -: the standard output is a terminal; redirect it to a file or pipe");
+  }
+  if (spec.output && *spec.output != "-") {
     if (Status s = check_output_path(*spec.output); !s.ok()) return s;
   }
   RenderOptions options = spec.options;
@@ -373,6 +385,7 @@ Result<Job> prepare(const JobSpec& spec, const Loaders& loaders) {
   job.output = spec.output;
   job.frames = spec.frames;
   job.quiet = spec.quiet;
+  job.jpeg_quality = spec.jpeg_quality;
   return job;
 }
 

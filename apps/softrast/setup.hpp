@@ -17,6 +17,7 @@
 #include "framing.hpp"
 #include "softrast/camera.hpp"
 #include "softrast/framebuffer.hpp"
+#include "softrast/image.hpp"
 #include "softrast/mesh.hpp"
 #include "softrast/renderer.hpp"
 #include "softrast/status.hpp"
@@ -39,6 +40,7 @@ struct JobSpec {
   glm::vec4 background{0.1f, 0.1f, 0.1f, 1.0f};
   int frames = 0;  // 0: one untimed render
   bool quiet = false;
+  int jpeg_quality = kDefaultJpegQuality;
 };
 
 // The mesh and the camera to see it with.
@@ -63,6 +65,7 @@ struct Job {
   std::optional<std::string> output;
   int frames = 0;
   bool quiet = false;
+  int jpeg_quality = kDefaultJpegQuality;  // for .jpg output
 };
 
 // How prepare() reads files; `softrast batch` passes loaders that keep what its jobs share. An

@@ -83,7 +83,7 @@ Result<ViewScene> load_view_scene(const std::vector<std::string>& models, float 
     return scene;
   }
   for (const std::string& path : models) {
-    Result<Mesh> mesh = load_obj(path);
+    Result<Mesh> mesh = load_model(path);
     if (!mesh) return mesh.status();
     append_mesh(scene.mesh, std::move(*mesh));
   }

@@ -1,8 +1,9 @@
-// softrast/image.hpp: RGBA8 images in memory and their files (PNG, TGA, JPG in; PNG, TGA out).
+// softrast/image.hpp: RGBA8 images in memory and their files (PNG, TGA, JPG in and out).
 // Row 0 is the top row of the picture, as in the files; nothing here flips.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,10 +50,28 @@ Result<Image> load_image(const std::string& path);
 // messages.
 Result<Image> decode_image(const uint8_t* data, size_t size, const std::string& name);
 
-// Writes `image` as PNG or TGA, chosen by the extension of `path` (.png, .tga; case-insensitive).
+// The file formats save_image and encode_image write.
+enum class ImageFormat { kPng, kTga, kJpeg };
+
+// JPEG quality when none is given (libjpeg's 1..100 scale): no visible blocks on renders.
+inline constexpr int kDefaultJpegQuality = 90;
+
+// The format named by the extension of `path`: .png, .tga, .jpg or .jpeg, in any case; nullopt for
+// anything else.
+std::optional<ImageFormat> image_format_of(const std::string& path);
+
+// The whole file for `image` in `format`. PNG is lossless (zlib level 1, the SUB filter; RGB when
+// every alpha is 255) and reads back through load_image bit for bit; TGA is lossless; JPEG drops
+// alpha and is lossy at `jpeg_quality` (1..100). Errors: an image whose size is outside
+// 1..kMaxImageSize or whose buffer does not match it, a quality outside 1..100, an encoder failure.
+Result<std::vector<uint8_t>> encode_image(const Image& image, ImageFormat format,
+                                          int jpeg_quality = kDefaultJpegQuality);
+
+// Writes `image` as PNG, TGA or JPEG, chosen by the extension of `path` (image_format_of).
 // The file appears complete or not at all: the data goes to a temporary file in the same folder
 // that is renamed over `path` only after a successful write.
-Status save_image(const std::string& path, const Image& image);
+Status save_image(const std::string& path, const Image& image,
+                  int jpeg_quality = kDefaultJpegQuality);
 
 // Removes the temporary file of a save_image in progress, if there is one. Async-signal-safe (it
 // reads a fixed buffer and calls unlink), for the SIGINT/SIGTERM handler of a program that then

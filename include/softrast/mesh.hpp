@@ -37,6 +37,9 @@ struct Mesh {
   std::vector<uint32_t> indices;   // three per triangle
   std::vector<SubMesh> submeshes;  // cover `indices`; empty means one run with material -1
   std::vector<Material> materials;
+  // Problems the loader worked around, one line each ("model.obj:1: ..."): a missing MTL library,
+  // a missing or unreadable map_Kd texture. The mesh is usable; a program shows these to the user.
+  std::vector<std::string> warnings;
 
   size_t vertex_count() const { return positions.size(); }
   size_t triangle_count() const { return indices.size() / 3; }
@@ -51,14 +54,43 @@ inline constexpr int64_t kMaxMtlFileBytes = int64_t(64) << 20;
 
 // Loads a Wavefront OBJ (polygons fan-triangulated) with its MTL libraries (Kd and map_Kd at
 // least); v, vt, vn, f, usemtl and mtllib are read, other statements skipped. Texture paths are
-// relative to the MTL file, MTL paths to the OBJ; a missing MTL leaves its materials undefined
-// (their faces get the default material). Errors name the file and, where there is one, the line
+// relative to the MTL file, MTL paths to the OBJ. A missing MTL leaves its materials undefined
+// (their faces get the default material) and a missing or unreadable map_Kd leaves its material
+// untextured; both add a line to Mesh::warnings:
+//   "model.obj:1: material library 'model.mtl' not found; its materials get the default colour"
+//   "model.obj: material 'skin': map_Kd: skin.png: cannot open: No such file or directory; drawn
+//    without this texture"  (the second part is load_image's message)
+// Errors name the file and, where there is one, the line
 // ("model.obj:12: face index 99999999999999999999 is out of range (1..3 or -3..-1)"): missing or
 // unreadable file, a folder, more than kMaxObjFileBytes (kMaxMtlFileBytes for an MTL; a pipe or
 // device is cut off there), a NUL byte (not a text file), a line over 1 MiB, a number that is not
 // one or not finite as a float, a face with fewer than 3 corners or an index that is zero, out
-// of range or overflowing, no faces, an unreadable texture.
+// of range or overflowing, no faces, an MTL file that exists but cannot be read or is malformed.
 Result<Mesh> load_obj(const std::string& path);
+
+// Loads a PLY file: ASCII, binary little or big endian. The vertex element's x, y, z, and when
+// present nx, ny, nz and u, v (or s, t, texture_u, texture_v, texture_s, texture_t); colours and
+// other properties are read and dropped. Faces are the face element's vertex_indices (or
+// vertex_index) list of any integer types, fan-triangulated. Without normals, smooth normals are
+// computed. Errors name the file and the line (ASCII) or the element and byte (binary): a bad
+// header, counts that need more bytes than the file has (checked before allocating), lists over
+// 65536 items, a number that does not fit its type, a vertex index out of range, no faces.
+Result<Mesh> load_ply(const std::string& path);
+
+// Loads an STL file, binary (exactly 84 + 50 * count bytes) or ASCII (solid ... endsolid). Every
+// triangle gets three vertices of its own with the facet normal (the triangle's own normal where
+// the facet normal is zero or not finite), uv (0, 0). Errors: a size that disagrees with the
+// count (truncated), a keyword out of place or missing (the file and line), a number that is not
+// one or not finite, no triangles.
+Result<Mesh> load_stl(const std::string& path);
+
+// Loads a model, telling the format by content: PLY by its "ply" line, binary STL by its size,
+// ASCII STL by "solid", OBJ otherwise. A file that looks like something else is refused with what
+// it looks like: "x.png: this is a PNG image, not a model (softrast reads OBJ, PLY and STL)"
+// (PNG, JPEG, GIF, BMP, TGA images, glTF/GLB scenes, ZIP, PDF, gzip, ELF, FBX). A .stl or .ply
+// name whose content is neither goes to that format's loader, which says why it is not one.
+// Pipes and devices (which can be read only once) are read as OBJ.
+Result<Mesh> load_model(const std::string& path);
 
 // Fills `mesh.normals` with area-weighted smooth normals per position (used when the file has
 // none). Degenerate neighbourhoods get (0, 0, 1).

@@ -1,6 +1,7 @@
 // io/image_io.cpp: image files in and out. Reading picks PNG, JPEG or TGA by the file's contents
-// and hands it to that format's decoder (io/*_decode.cpp); writing goes through stb_image_write
-// and a temporary file that is renamed over the target.
+// and hands it to that format's decoder (io/*_decode.cpp); writing encodes in memory (PNG and JPEG
+// in io/image_encode.cpp, TGA through stb_image_write) and goes through a temporary file that is
+// renamed over the target.
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -22,6 +23,7 @@
 #include <stb_image_write.h>
 
 #include "io/image_decode.hpp"
+#include "io/image_encode.hpp"
 #include "softrast/image.hpp"
 
 namespace softrast {
@@ -102,31 +104,20 @@ Status read_file(const std::string& path, std::vector<uint8_t>& bytes) {
   return {};
 }
 
-enum class Format { kUnknown, kPng, kTga };
-
-Format format_of(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return char(std::tolower(c)); });
-  if (ext == ".png") return Format::kPng;
-  if (ext == ".tga") return Format::kTga;
-  return Format::kUnknown;
-}
-
 void append_bytes(void* context, void* data, int size) {
   auto* out = static_cast<std::vector<uint8_t>*>(context);
   const auto* bytes = static_cast<const uint8_t*>(data);
   out->insert(out->end(), bytes, bytes + size);
 }
 
-// Encodes into memory; stb reports failure (e.g. out of memory) by returning 0.
-bool encode(Format format, const Image& image, std::vector<uint8_t>& out) {
-  if (format == Format::kPng) {
-    return stbi_write_png_to_func(append_bytes, &out, image.width, image.height, 4,
-                                  image.rgba.data(), image.width * 4) != 0;
+// TGA through stb_image_write, which reports failure (e.g. out of memory) by returning 0.
+Result<std::vector<uint8_t>> encode_tga(const Image& image) {
+  std::vector<uint8_t> out;
+  if (stbi_write_tga_to_func(append_bytes, &out, image.width, image.height, 4, image.rgba.data()) ==
+      0) {
+    return Status::error("cannot encode TGA");
   }
-  return stbi_write_tga_to_func(append_bytes, &out, image.width, image.height, 4,
-                                image.rgba.data()) != 0;
+  return out;
 }
 
 // A name no other writer uses: the pid separates processes, the counter threads of this one.
@@ -245,16 +236,43 @@ Result<Image> load_image(const std::string& path) {
   return decode_image(bytes.data(), bytes.size(), path);
 }
 
-Status save_image(const std::string& path, const Image& image) {
-  Format format = format_of(path);
-  if (format == Format::kUnknown) return fail(path, "unknown image extension (use .png or .tga)");
+std::optional<ImageFormat> image_format_of(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext == ".png") return ImageFormat::kPng;
+  if (ext == ".tga") return ImageFormat::kTga;
+  if (ext == ".jpg" || ext == ".jpeg") return ImageFormat::kJpeg;
+  return std::nullopt;
+}
+
+Result<std::vector<uint8_t>> encode_image(const Image& image, ImageFormat format,
+                                          int jpeg_quality) {
   if (!valid_size(image.width, image.height) ||
       image.rgba.size() != size_t(image.width) * size_t(image.height) * 4) {
-    return fail(path, "invalid image " + size_text(image.width, image.height) + " with " +
-                          std::to_string(image.rgba.size()) + " bytes");
+    return Status::error("invalid image " + size_text(image.width, image.height) + " with " +
+                         std::to_string(image.rgba.size()) + " bytes");
   }
-  std::vector<uint8_t> bytes;
-  if (!encode(format, image, bytes)) return fail(path, "cannot encode image");
+  switch (format) {
+    case ImageFormat::kPng:
+      return detail::encode_png(image);
+    case ImageFormat::kJpeg:
+      if (jpeg_quality < 1 || jpeg_quality > 100) {
+        return Status::error("JPEG quality " + std::to_string(jpeg_quality) + " is outside 1..100");
+      }
+      return detail::encode_jpeg(image, jpeg_quality);
+    case ImageFormat::kTga:
+      break;
+  }
+  return encode_tga(image);
+}
+
+Status save_image(const std::string& path, const Image& image, int jpeg_quality) {
+  std::optional<ImageFormat> format = image_format_of(path);
+  if (!format) return fail(path, "unknown image extension (use .png, .jpg or .tga)");
+  Result<std::vector<uint8_t>> encoded = encode_image(image, *format, jpeg_quality);
+  if (!encoded) return fail(path, encoded.status().message());
+  const std::vector<uint8_t>& bytes = *encoded;
   std::string temporary = temporary_name(path);
   PendingTemporary pending(temporary);
   if (std::string reason; !write_new_file(temporary, bytes, reason)) {

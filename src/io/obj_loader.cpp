@@ -1,47 +1,66 @@
 // io/obj_loader.cpp: Wavefront OBJ files into indexed meshes, with their MTL libraries.
 //
-// The OBJ text is parsed here, line by line as it is read, not by tinyobjloader: tinyobj reads
-// indices with atoi, so 99999999999999999999 or 4294967299 became some other index silently, its
-// number parser overflows an int on an exponent such as 1e2147483648, its skin-weight extension
-// casts 1e39 to int, and holding its per-corner arrays beside the whole text took 1.83 GB for an
-// 80 MB file. Only v, vt, vn, f, usemtl and mtllib matter for rendering; every other statement
-// (o, g, s, l, p, vw, ...) is skipped without being parsed. MTL files still go to tinyobj's
-// LoadMtl, after their numbers have been checked for the exponents it would overflow on.
+// The OBJ text is parsed here, not by tinyobjloader: tinyobj reads indices with atoi, so
+// 99999999999999999999 or 4294967299 became some other index silently, its number parser
+// overflows an int on an exponent such as 1e2147483648, and holding its per-corner arrays beside
+// the whole text took 1.83 GB for an 80 MB file. MTL files still go to tinyobj's LoadMtl
+// (io/mtl_materials.cpp). Also ours: the fan triangulation (tinyobj splits quads along the
+// shorter diagonal).
 //
-// Also ours: the fan triangulation (tinyobj splits quads along the shorter diagonal) and knowing
-// which materials had a Kd (tinyobj cannot tell a missing Kd from Kd 0 0 0).
+// In parallel, in bounded memory: the file is read in pieces of about 1 MiB cut at line ends;
+// worker threads parse pieces (io/obj_piece.cpp) while this thread reads on and merges finished
+// pieces strictly in file order. What a piece cannot know alone is completed by the merge: the
+// element counts before it (negative indices reaching back past its start, and the counts in
+// messages), its first line number, and the materials named so far. Errors are therefore the same
+// as a line-by-line reading gives, at the same line: the first in file order wins. At most
+// kWindow pieces are in flight, so the text never sits in memory whole; the arrays grow in
+// chunks, never by doubling; the per-piece index arrays are joined once at the end.
+//
+// Memory, for the benchmark's 109 MB spheres_1m.obj (551,232 vertices, 995,328 triangles; the
+// final mesh is 29.6 MB): the raw elements (17.6 MB), the vertex table (8.8 MB: key, chain link
+// and head per vertex) and the indices (11.9 MB) at the end of reading, plus the pieces in flight.
 
 #include "io/obj_loader.hpp"
 
-#include <array>
-#include <charconv>
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <condition_variable>
 #include <cstdint>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <limits>
-#include <map>
 #include <memory>
-#include <set>
-#include <sstream>
+#include <mutex>
+#include <new>
 #include <string>
-#include <string_view>
-#include <system_error>
+#include <thread>
 #include <unordered_map>
 #include <vector>
 
-#include <tiny_obj_loader.h>
+#include <malloc.h>
+
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include "io/mtl_materials.hpp"
+#include "io/obj_piece.hpp"
 #include "io/text_lines.hpp"
-#include "softrast/image.hpp"
 #include "softrast/mesh.hpp"
 
 namespace softrast {
 namespace {
 
 namespace fs = std::filesystem;
+using detail::kObjAbsent;
+using detail::kObjComponents;
+using detail::ObjCorner;
+using detail::ObjPiece;
+
+// Bytes read per piece (plus the end of a line carried over from the previous read). Large
+// enough that the per-piece overhead vanishes, small enough that pieces in flight stay cheap.
+constexpr size_t kPieceBytes = size_t(1) << 20;
 
 Status fail(const std::string& path, const std::string& reason) {
   return Status::error(path + ": " + reason);
@@ -51,102 +70,97 @@ Status fail_at(const std::string& path, size_t line, const std::string& reason) 
   return Status::error(path + ":" + std::to_string(line) + ": " + reason);
 }
 
-// The words of a line, split at spaces and tabs; a word starting with '#' ends the line.
-class Words {
- public:
-  explicit Words(std::string_view line) : rest_(line) {}
+const char* const kPlural[3] = {"positions", "texture coordinates", "normals"};
+const char* const kIndexName[3] = {"face index", "texture coordinate index", "normal index"};
 
-  // The next word, or an empty view at the end of the line.
-  std::string_view next() {
-    size_t start = rest_.find_first_not_of(kSpace);
-    if (start == std::string_view::npos || rest_[start] == '#') {
-      rest_ = {};
-      return {};
-    }
-    rest_.remove_prefix(start);
-    std::string_view word = rest_.substr(0, rest_.find_first_of(kSpace));
-    rest_.remove_prefix(word.size());
-    return word;
-  }
-
- private:
-  static constexpr const char* kSpace = " \t\r\v\f";
-  std::string_view rest_;
-};
-
-enum class Number { kOk, kNotNumber, kOutOfRange };
-
-// Parses a whole word as a finite float: "1", "-0.5", "+.5e3". Doubles first, so 1e39 is seen to
-// be out of float range instead of being cast (undefined behaviour) or becoming infinity.
-Number parse_float(std::string_view word, float& value) {
-  if (word.size() > 1 && word[0] == '+' && word[1] != '-') word.remove_prefix(1);
-  double d = 0.0;
-  auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), d);
-  if (ec == std::errc::result_out_of_range) return Number::kOutOfRange;
-  if (ec != std::errc() || end != word.data() + word.size()) return Number::kNotNumber;
-  if (!(std::fabs(d) <= double(std::numeric_limits<float>::max()))) return Number::kOutOfRange;
-  value = float(d);
-  return Number::kOk;
-}
-
-std::string quoted(std::string_view word) {
-  std::string text(1, '\'');  // appended, not "'" + ...: GCC 12 warns falsely about the latter
-  text.append(word);
-  return text += '\'';
-}
-
-// An attribute array (positions, texture coordinates or normals) and what faces ask of it.
-struct Attribute {
-  const char* name;        // for messages: "position"
-  const char* plural;      // "positions"
-  const char* index_name;  // "face index"
-  size_t components;
-  std::vector<float> values;
-  // Positive indices may name elements defined further down; the largest one past the elements
-  // read so far is checked against the final count, and reported with its line.
-  int64_t forward_max = 0;
-  size_t forward_line = 0;
-
-  size_t count() const { return values.size() / components; }
-};
-
-std::string range_text(const Attribute& a, size_t count) {
-  if (count == 0) return "(there are no " + std::string(a.plural) + ")";
+std::string range_text(int attr, size_t count) {
+  if (count == 0) return "(there are no " + std::string(kPlural[attr]) + ")";
   std::string n = std::to_string(count);
   return "(1.." + n + " or -" + n + "..-1)";
 }
 
-// Builds the indexed mesh: one vertex per distinct (position, uv, normal) index triple. Vertices
-// keep their indices until finish(), so faces may name elements defined after them.
-class MeshBuilder {
+std::string out_of_range(int attr, const std::string& word, size_t count) {
+  return std::string(kIndexName[attr]) + " " + word + " is out of range " + range_text(attr, count);
+}
+
+// One element array (positions, uvs or normals) in chunks of 2^16 elements: appending never
+// copies what is there, and there is no doubling slack.
+class ChunkedValues {
+ public:
+  explicit ChunkedValues(size_t components) : components_(components) {}
+
+  void append(const std::vector<float>& values) {
+    size_t elements = values.size() / components_;
+    for (size_t done = 0; done < elements;) {
+      if ((count_ & kMask) == 0) {
+        chunks_.emplace_back();
+        chunks_.back().reserve(kChunk * components_);
+      }
+      size_t n = std::min(elements - done, kChunk - (count_ & kMask));
+      const float* from = values.data() + done * components_;
+      chunks_.back().insert(chunks_.back().end(), from, from + n * components_);
+      done += n;
+      count_ += n;
+    }
+  }
+  size_t count() const { return count_; }
+  const float* at(size_t i) const {
+    return chunks_[i >> kShift].data() + (i & kMask) * components_;
+  }
+  void release() { chunks_ = {}; }
+
+ private:
+  static constexpr size_t kShift = 16;
+  static constexpr size_t kChunk = size_t(1) << kShift;
+  static constexpr size_t kMask = kChunk - 1;
+  size_t components_;
+  size_t count_ = 0;
+  std::vector<std::vector<float>> chunks_;
+};
+
+// One vertex per distinct (position, uv, normal) index triple, numbered in order of first use.
+// A table indexed by position heads a chain of the vertices sharing that position (short: one per
+// uv seam or crease), which is several times faster than a hash map over triples. Keys whose
+// position has not been read yet (OBJ allows faces before their vertices) go to a hash map; it
+// is searched first while it is not empty, so a key always finds the vertex made for it.
+class VertexTable {
  public:
   struct Key {
-    int v, vt, vn;  // 0-based; -1 for an absent uv or normal
+    int32_t v, vt, vn;  // 0-based; -1 for an absent uv or normal
     bool operator==(const Key&) const = default;
   };
 
-  // Fans around the first corner: (0, 1, 2), (0, 2, 3), ...
-  void add_face(const std::vector<Key>& corners, int material) {
-    if (mesh_.submeshes.empty() || mesh_.submeshes.back().material != material) {
-      mesh_.submeshes.push_back({uint32_t(mesh_.indices.size()), 0, material});
+  void grow_positions(size_t count) { head_.resize(count, kNone); }
+
+  uint32_t vertex(const Key& key) {
+    if (!forward_.empty()) {
+      if (auto it = forward_.find(key); it != forward_.end()) return it->second;
     }
-    uint32_t first = vertex(corners[0]);
-    uint32_t previous = vertex(corners[1]);
-    for (size_t k = 2; k < corners.size(); ++k) {
-      uint32_t current = vertex(corners[k]);
-      mesh_.indices.insert(mesh_.indices.end(), {first, previous, current});
-      previous = current;
+    auto id = uint32_t(keys_.size());
+    if (size_t(key.v) < head_.size()) {
+      for (uint32_t at = head_[size_t(key.v)]; at != kNone; at = next_[at]) {
+        if (keys_[at].vt == key.vt && keys_[at].vn == key.vn) return at;
+      }
+      next_.push_back(head_[size_t(key.v)]);
+      head_[size_t(key.v)] = id;
+    } else {
+      next_.push_back(kNone);
+      forward_.emplace(key, id);
     }
-    mesh_.submeshes.back().index_count += uint32_t(3 * (corners.size() - 2));
+    keys_.push_back(key);
+    return id;
   }
 
-  size_t index_count() const { return mesh_.indices.size(); }
-
-  // Looks up each vertex's attributes; missing normals become smooth normals per OBJ position
-  // index, so vertices that share a position but not a uv still get the same normal.
-  Mesh finish(const Attribute& positions, const Attribute& uvs, const Attribute& normals);
+  const std::vector<Key>& keys() const { return keys_; }
+  void release_keys() { keys_ = {}; }
+  void release_lookup() {
+    head_ = {};
+    next_ = {};
+    forward_ = {};
+  }
 
  private:
+  static constexpr uint32_t kNone = UINT32_MAX;
   struct KeyHash {
     size_t operator()(const Key& k) const {
       uint64_t h = uint64_t(uint32_t(k.v)) * 0x9E3779B97F4A7C15ull;
@@ -155,16 +169,10 @@ class MeshBuilder {
       return size_t(h ^ (h >> 29));
     }
   };
-
-  uint32_t vertex(const Key& key) {
-    auto [it, inserted] = vertices_.try_emplace(key, uint32_t(keys_.size()));
-    if (inserted) keys_.push_back(key);
-    return it->second;
-  }
-
-  Mesh mesh_;
-  std::unordered_map<Key, uint32_t, KeyHash> vertices_;
-  std::vector<Key> keys_;  // per vertex
+  std::vector<uint32_t> head_;  // per position
+  std::vector<uint32_t> next_;  // per vertex
+  std::vector<Key> keys_;       // per vertex
+  std::unordered_map<Key, uint32_t, KeyHash> forward_;
 };
 
 // Sums of area-weighted face normals per group of vertices. The cross product of two edges is
@@ -188,318 +196,410 @@ glm::vec3 unit_or_z(const glm::dvec3& n) {
   return glm::vec3(n / length);
 }
 
-Mesh MeshBuilder::finish(const Attribute& positions, const Attribute& uvs,
-                         const Attribute& normals) {
-  vertices_ = {};  // free the table before the arrays grow
-  const float *p = positions.values.data(), *t = uvs.values.data(), *n = normals.values.data();
-  mesh_.positions.reserve(keys_.size());
-  mesh_.uvs.reserve(keys_.size());
-  mesh_.normals.reserve(keys_.size());
-  bool needs_smoothing = false;
-  for (const Key& k : keys_) {
-    size_t v = size_t(k.v), vt = size_t(k.vt), vn = size_t(k.vn);
-    mesh_.positions.emplace_back(p[3 * v], p[3 * v + 1], p[3 * v + 2]);
-    mesh_.uvs.push_back(k.vt >= 0 ? glm::vec2(t[2 * vt], t[2 * vt + 1]) : glm::vec2(0.0f));
-    mesh_.normals.push_back(k.vn >= 0 ? glm::vec3(n[3 * vn], n[3 * vn + 1], n[3 * vn + 2])
-                                      : glm::vec3(0.0f));
-    needs_smoothing = needs_smoothing || k.vn < 0;
-  }
-  if (needs_smoothing) {
-    std::vector<uint32_t> position_index(keys_.size());
-    for (size_t v = 0; v < keys_.size(); ++v) position_index[v] = uint32_t(keys_[v].v);
-    auto sums = group_normal_sums(mesh_, position_index, positions.count());
-    for (size_t v = 0; v < keys_.size(); ++v) {
-      if (keys_[v].vn < 0) mesh_.normals[v] = unit_or_z(sums[position_index[v]]);
-    }
-  }
-  return std::move(mesh_);
+// Pieces are allocated by the worker threads (in their malloc arenas) and freed here, and the raw
+// arrays are freed before the final ones grow: glibc keeps such memory mapped, counted in the
+// resident size, until told to give back its free pages (malloc_trim returns whole free pages
+// from every arena, not only from the top of the heap). Every few pieces and once before the
+// indices are joined; each call takes well under a millisecond.
+constexpr size_t kTrimEvery = 8;
+
+void return_free_memory() {
+  malloc_trim(0);
 }
 
-// Whether tinyobj's number parser would overflow on `word`, or cast it to a float out of range
-// (both undefined behaviour). It adds exponent digits to an int, checking only before
-// multiplying, so more than 9 significant exponent digits are refused even at the start of a word
-// (it parses prefixes); nine stay below 2^31 / 10, and a sane file never has more than three.
-bool mtl_number_out_of_range(std::string_view word) {
-  float ignored = 0.0f;
-  if (parse_float(word, ignored) == Number::kOutOfRange && word.find_first_of("nN") == word.npos) {
-    return true;  // inf and nan are words tinyobj does not parse as numbers
-  }
-  size_t e = word.find_first_of("eE");
-  if (e == std::string_view::npos) return false;
-  size_t start = word.find_first_not_of("+-0", e + 1);
-  if (start == std::string_view::npos) return false;
-  size_t digits = 0;
-  while (start + digits < word.size() && word[start + digits] >= '0' &&
-         word[start + digits] <= '9') {
-    ++digits;
-  }
-  return digits > 9;
-}
-
-// For each material that tinyobj::LoadMtl will produce from `text`, in its order, whether the
-// MTL gave it a Kd. Mirrors LoadMtl: one material per `newmtl` line (names are never empty
-// after its trimming), or a single unnamed one if there is no `newmtl` at all.
-std::vector<bool> scan_kd(const std::string& text) {
-  std::vector<bool> has_kd;
-  bool unnamed_kd = false;
-  std::istringstream in(text);
-  std::string line;
-  while (std::getline(in, line, '\n')) {
-    const char* token = line.c_str() + std::strspn(line.c_str(), " \t");
-    bool is_newmtl = std::strncmp(token, "newmtl", 6) == 0 && (token[6] == ' ' || token[6] == '\t');
-    bool is_kd = token[0] == 'K' && token[1] == 'd' && (token[2] == ' ' || token[2] == '\t');
-    if (is_newmtl) has_kd.push_back(false);
-    if (is_kd && has_kd.empty()) unnamed_kd = true;
-    if (is_kd && !has_kd.empty()) has_kd.back() = true;
-  }
-  if (has_kd.empty()) has_kd.push_back(unnamed_kd);
-  return has_kd;
-}
-
-// The materials of every MTL library the OBJ names, relative to the OBJ's folder, each with its
-// MTL's folder (texture paths are relative to it) and whether it had a Kd. A missing MTL is not an
-// error: the OBJ then has no materials from it, as with other loaders.
-class Materials {
+// Merges parsed pieces in file order into the mesh, then finishes it.
+class ObjMerge {
  public:
-  Materials(fs::path obj_dir, int64_t max_mtl_bytes)
-      : obj_dir_(std::move(obj_dir)), max_bytes_(max_mtl_bytes) {}
-
-  Status load_library(const std::string& name) {
-    if (!loaded_.insert(name).second) return {};
-    fs::path path = obj_dir_ / name;
-    std::error_code ignored;
-    if (!fs::exists(path, ignored)) return {};
-    std::string text;
-    Status read = detail::read_lines(
-        path.string(), {max_bytes_, "MTL files"}, [&](std::string_view line, size_t number) {
-          Words words(line);
-          for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
-            if (mtl_number_out_of_range(w)) {
-              return fail_at(path.string(), number,
-                             "number " + std::string(w) + " is out of range");
-            }
-          }
-          text.append(line);
-          text += '\n';
-          return Status();
-        });
-    if (!read.ok()) return read;
-    size_t first = all_.size();
-    std::istringstream in(text);
-    std::string warn;
-    tinyobj::LoadMtl(&ids_, &all_, &in, &warn, nullptr);
-    std::vector<bool> kd = scan_kd(text);
-    // Should the scan ever disagree with tinyobj, trust tinyobj's Kd values.
-    kd.resize(all_.size() - first, true);
-    has_kd_.insert(has_kd_.end(), kd.begin(), kd.end());
-    dirs_.resize(all_.size(), path.parent_path());
-    return {};
-  }
-
-  // The material's index, or -1 (the default material) for a name no library defined.
-  int id(const std::string& name) const {
-    auto it = ids_.find(name);
-    return it == ids_.end() ? -1 : it->second;
-  }
-
-  Result<std::vector<Material>> convert(const std::string& path) const;
-
- private:
-  fs::path obj_dir_;
-  int64_t max_bytes_;
-  std::set<std::string> loaded_;
-  std::map<std::string, int> ids_;
-  std::vector<tinyobj::material_t> all_;
-  std::vector<fs::path> dirs_;
-  std::vector<bool> has_kd_;
-};
-
-// Returns the texture at `file`, loading it on first use so that materials share it.
-using TextureCache = std::map<std::string, std::shared_ptr<const Texture>>;
-
-Result<std::shared_ptr<const Texture>> texture_at(const fs::path& file, TextureCache& cache) {
-  std::string key = file.lexically_normal().string();
-  if (auto it = cache.find(key); it != cache.end()) return it->second;
-  Result<Image> image = load_image(key);
-  if (!image.ok()) return image.status();
-  auto texture = std::make_shared<const Texture>(Texture::from_image(*image));
-  cache.emplace(key, texture);
-  return std::shared_ptr<const Texture>(texture);
-}
-
-Result<std::vector<Material>> Materials::convert(const std::string& path) const {
-  std::vector<Material> materials;
-  TextureCache cache;
-  for (size_t i = 0; i < all_.size(); ++i) {
-    const tinyobj::material_t& source = all_[i];
-    Material material;
-    material.name = source.name;
-    if (has_kd_[i]) {
-      material.diffuse = {source.diffuse[0], source.diffuse[1], source.diffuse[2]};
-      if (!std::isfinite(material.diffuse.x + material.diffuse.y + material.diffuse.z)) {
-        return fail(path, "Kd of material '" + source.name + "' is not finite");
-      }
-    }
-    if (!source.diffuse_texname.empty()) {
-      auto texture = texture_at(dirs_[i] / source.diffuse_texname, cache);
-      if (!texture.ok()) {
-        return fail(path,
-                    "map_Kd of material '" + source.name + "': " + texture.status().message());
-      }
-      material.diffuse_map = *texture;
-    }
-    materials.push_back(std::move(material));
-  }
-  return materials;
-}
-
-// Parses the OBJ statements that matter, one line at a time.
-class ObjParser {
- public:
-  ObjParser(const std::string& path, int64_t max_mtl_bytes)
+  ObjMerge(const std::string& path, int64_t max_mtl_bytes)
       : path_(path), materials_(fs::path(path).parent_path(), max_mtl_bytes) {}
 
-  Status line(std::string_view text, size_t number) {
-    line_ = number;
-    Words words(text);
-    std::string_view keyword = words.next();
-    if (keyword == "v") return numbers(words, positions_, 3, 3);
-    if (keyword == "vt") return numbers(words, uvs_, 1, 2);
-    if (keyword == "vn") return numbers(words, normals_, 3, 3);
-    if (keyword == "f") return face(words);
-    if (keyword == "usemtl") {
-      material_ = materials_.id(std::string(words.next()));
-      return {};
-    }
-    if (keyword == "mtllib") return libraries(words);
-    return {};  // comments, groups, objects, smoothing, lines, points, and anything unknown
-  }
+  // Lines merged so far (for errors found by the reader after them).
+  size_t lines() const { return lines_; }
 
+  Status merge(ObjPiece& piece);
   Result<Mesh> finish();
 
  private:
-  Status error(const std::string& reason) const { return fail_at(path_, line_, reason); }
-
-  // Appends `stored` components from at least `required` numbers; the rest (w, vertex colours)
-  // must be numbers too and are dropped; missing optional ones are 0.
-  Status numbers(Words& words, Attribute& a, size_t required, size_t stored) {
-    size_t read = 0;
-    for (std::string_view w = words.next(); !w.empty(); w = words.next(), ++read) {
-      float value = 0.0f;
-      Number n = parse_float(w, value);
-      if (n == Number::kNotNumber) return error(quoted(w) + " is not a number");
-      if (n == Number::kOutOfRange) {
-        return error("number " + std::string(w) + " is not finite as a 32-bit float");
-      }
-      if (read < stored) a.values.push_back(value);
-    }
-    if (read < required) {
-      return error(std::string(a.name) + " with fewer than " + std::to_string(required) +
-                   (required == 1 ? " number" : " numbers"));
-    }
-    for (; read < stored; ++read) a.values.push_back(0.0f);
-    return {};
-  }
-
-  // Resolves one index of a corner: 1-based, or negative counting back from the latest element.
-  Status resolve(std::string_view word, Attribute& a, int& index) {
-    int64_t value = 0;
-    auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), value);
-    bool overflow = ec == std::errc::result_out_of_range;
-    if (!overflow && (ec != std::errc() || end != word.data() + word.size())) {
-      return error("bad face corner: " + quoted(word) + " is not an index");
-    }
-    int64_t count = int64_t(a.count());
-    if (!overflow && value < 0 && -value <= count) {
-      index = int(count + value);
-      return {};
-    }
-    if (!overflow && value > 0 && value <= std::numeric_limits<int>::max()) {
-      if (value > count && value > a.forward_max) {
-        a.forward_max = value;
-        a.forward_line = line_;
-      }
-      index = int(value - 1);
-      return {};
-    }
-    return error(std::string(a.index_name) + " " + std::string(word) + " is out of range " +
-                 range_text(a, a.count()));
-  }
-
-  Status bad_corner(std::string_view word) const {
-    return error("bad face corner " + quoted(word) + " (v, v/vt, v//vn or v/vt/vn)");
-  }
-
-  // "v", "v/vt", "v//vn" or "v/vt/vn".
-  Status corner(std::string_view word, MeshBuilder::Key& key) {
-    key = {0, -1, -1};
-    size_t slash = word.find('/');
-    std::string_view v = word.substr(0, slash);
-    if (v.empty()) return bad_corner(word);
-    if (Status s = resolve(v, positions_, key.v); !s.ok()) return s;
-    if (slash == std::string_view::npos) return {};
-    std::string_view rest = word.substr(slash + 1);
-    slash = rest.find('/');
-    std::string_view vt = rest.substr(0, slash);
-    if (slash == std::string_view::npos) {
-      return vt.empty() ? bad_corner(word) : resolve(vt, uvs_, key.vt);
-    }
-    std::string_view vn = rest.substr(slash + 1);
-    if (vn.empty()) return bad_corner(word);
-    if (!vt.empty()) {
-      if (Status s = resolve(vt, uvs_, key.vt); !s.ok()) return s;
-    }
-    return resolve(vn, normals_, key.vn);
-  }
-
-  Status face(Words& words) {
-    corners_.clear();
-    for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
-      corners_.emplace_back();
-      if (Status s = corner(w, corners_.back()); !s.ok()) return s;
-    }
-    if (corners_.size() < 3) return error("face with fewer than 3 vertices");
-    // Fanning gives 3(n - 2) indices; first_index and index_count are 32-bit.
-    if (builder_.index_count() + 3 * corners_.size() > UINT32_MAX) return error("too many faces");
-    builder_.add_face(corners_, material_);
-    return {};
-  }
-
-  Status libraries(Words& words) {
-    for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
-      if (Status s = materials_.load_library(std::string(w)); !s.ok()) return s;
+  Status piece_error(const ObjPiece& piece) const;
+  Status first_fixup_error(ObjPiece& piece, const size_t offset[3], size_t& line) const;
+  Status load_libraries(const detail::ObjEvent& event) {
+    for (const std::string& name : event.names) {
+      if (Status s = materials_.load_library(name, path_, lines_ + event.line); !s.ok()) return s;
     }
     return {};
   }
-
-  Status check_forward(const Attribute& a) const {
-    if (a.forward_max <= int64_t(a.count())) return {};
-    return fail_at(path_, a.forward_line,
-                   std::string(a.index_name) + " " + std::to_string(a.forward_max) +
-                       " is out of range " + range_text(a, a.count()));
-  }
+  void add_faces(const ObjPiece& piece, const size_t offset[3], size_t end_face,
+                 std::vector<uint32_t>& indices);
+  Mesh build_mesh();
 
   const std::string& path_;
-  size_t line_ = 0;
-  Attribute positions_{"position", "positions", "face index", 3, {}};
-  Attribute uvs_{"texture coordinate", "texture coordinates", "texture coordinate index", 2, {}};
-  Attribute normals_{"normal", "normals", "normal index", 3, {}};
-  Materials materials_;
+  detail::ObjMaterials materials_;
+  size_t lines_ = 0;
+  ChunkedValues values_[3] = {ChunkedValues(3), ChunkedValues(2), ChunkedValues(3)};
+  detail::ObjLargest largest_[3];
+  VertexTable table_;
+  std::vector<std::vector<uint32_t>> index_pieces_;
+  size_t index_count_ = 0;
+  std::vector<SubMesh> submeshes_;
   int material_ = -1;
-  std::vector<MeshBuilder::Key> corners_;
-  MeshBuilder builder_;
+  size_t face_ = 0, corner_ = 0;  // cursor in the piece being merged
+  size_t pieces_ = 0;
 };
 
-Result<Mesh> ObjParser::finish() {
-  if (builder_.index_count() == 0) return fail(path_, "no faces");
-  for (const Attribute* a : {&positions_, &uvs_, &normals_}) {
-    if (Status s = check_forward(*a); !s.ok()) return s;
+Status ObjMerge::piece_error(const ObjPiece& piece) const {
+  const detail::ObjPieceError& e = *piece.error;
+  if (e.range_attr < 0) return fail_at(path_, lines_ + e.line, e.message);
+  size_t count = values_[e.range_attr].count() + e.local_count;
+  return fail_at(path_, lines_ + e.line, out_of_range(e.range_attr, e.word, count));
+}
+
+// Resolves the negative indices that reach back before the piece; the first out of range is an
+// error at its line (`line`, else SIZE_MAX).
+Status ObjMerge::first_fixup_error(ObjPiece& piece, const size_t offset[3], size_t& line) const {
+  line = SIZE_MAX;
+  for (const detail::ObjFixup& f : piece.fixups) {
+    int64_t global = int64_t(offset[f.attr]) + f.back;
+    if (global < 0) {
+      line = f.line;
+      return fail_at(path_, lines_ + f.line,
+                     out_of_range(f.attr, f.word, offset[f.attr] + f.local_count));
+    }
+    piece.corners[f.corner].index[f.attr] = int32_t(global);
   }
-  Result<std::vector<Material>> materials = materials_.convert(path_);
-  if (!materials.ok()) return materials.status();
-  Mesh mesh = builder_.finish(positions_, uvs_, normals_);
-  mesh.materials = std::move(*materials);
+  return {};
+}
+
+// Fans faces [face_, end_face) of the piece around their first corner: (0, 1, 2), (0, 2, 3), ...
+void ObjMerge::add_faces(const ObjPiece& piece, const size_t offset[3], size_t end_face,
+                         std::vector<uint32_t>& indices) {
+  auto key_of = [&](const ObjCorner& c) {
+    int32_t k[3];
+    for (int a = 0; a < 3; ++a) {
+      int32_t i = c.index[a];
+      k[a] = i == kObjAbsent ? -1 : i >= 0 ? i : int32_t(offset[a]) + (-1 - i);
+    }
+    return VertexTable::Key{k[0], k[1], k[2]};
+  };
+  for (; face_ < end_face; ++face_) {
+    size_t n = piece.face_sizes[face_];
+    if (submeshes_.empty() || submeshes_.back().material != material_) {
+      submeshes_.push_back({uint32_t(index_count_ + indices.size()), 0, material_});
+    }
+    const ObjCorner* c = &piece.corners[corner_];
+    uint32_t first = table_.vertex(key_of(c[0]));
+    uint32_t previous = table_.vertex(key_of(c[1]));
+    for (size_t k = 2; k < n; ++k) {
+      uint32_t current = table_.vertex(key_of(c[k]));
+      indices.insert(indices.end(), {first, previous, current});
+      previous = current;
+    }
+    submeshes_.back().index_count += uint32_t(3 * (n - 2));
+    corner_ += n;
+  }
+}
+
+Status ObjMerge::merge(ObjPiece& piece) {
+  if (piece.bad_alloc) throw std::bad_alloc();
+  size_t offset[3] = {values_[0].count(), values_[1].count(), values_[2].count()};
+  size_t fixup_line = SIZE_MAX;
+  Status fixup = first_fixup_error(piece, offset, fixup_line);
+  if (!fixup.ok() || piece.error) {
+    // Libraries named before the first error are still read: their errors come first.
+    size_t stop = std::min(fixup_line, piece.error ? piece.error->line : SIZE_MAX);
+    for (const detail::ObjEvent& event : piece.events) {
+      if (event.line >= stop) break;
+      if (event.mtllib) {
+        if (Status s = load_libraries(event); !s.ok()) return s;
+      }
+    }
+    return fixup.ok() ? piece_error(piece) : fixup;
+  }
+  // Fanning gives 3(n - 2) indices; first_index and index_count are 32-bit. (A file within
+  // kMaxObjFileBytes cannot get there: each corner costs at least 2 bytes for 3 indices.)
+  if (index_count_ + 3 * piece.triangles > UINT32_MAX) {
+    return fail_at(path_, lines_ + piece.lines, "too many faces");
+  }
+  for (int a = 0; a < 3; ++a) {
+    values_[a].append(piece.values[a]);
+    piece.values[a] = {};
+    if (piece.largest[a].value > largest_[a].value) {
+      largest_[a] = {piece.largest[a].value, lines_ + piece.largest[a].line};
+    }
+  }
+  table_.grow_positions(values_[0].count());
+  std::vector<uint32_t> indices;
+  indices.reserve(3 * piece.triangles);
+  face_ = corner_ = 0;
+  for (const detail::ObjEvent& event : piece.events) {
+    add_faces(piece, offset, event.face, indices);
+    if (!event.mtllib) {
+      material_ = materials_.id(event.names[0]);
+    } else if (Status s = load_libraries(event); !s.ok()) {
+      return s;
+    }
+  }
+  add_faces(piece, offset, piece.face_sizes.size(), indices);
+  index_count_ += indices.size();
+  if (!indices.empty()) index_pieces_.push_back(std::move(indices));
+  lines_ += piece.lines;
+  if (++pieces_ % kTrimEvery == 0) return_free_memory();
+  return {};
+}
+
+// The final arrays, built one at a time while the raw ones are released: the vertex arrays
+// first (each raw array freed once its final one is built), then the lookup table and keys, and
+// only then are the per-piece indices joined, so that at most one array exists twice.
+Mesh ObjMerge::build_mesh() {
+  Mesh mesh;
+  mesh.submeshes = std::move(submeshes_);
+  table_.release_lookup();
+  const std::vector<VertexTable::Key>& keys = table_.keys();
+  mesh.positions.resize(keys.size());
+  for (size_t i = 0; i < keys.size(); ++i) {
+    const float* p = values_[0].at(size_t(keys[i].v));
+    mesh.positions[i] = {p[0], p[1], p[2]};
+  }
+  size_t position_count = values_[0].count();
+  values_[0].release();
+  return_free_memory();
+  mesh.uvs.resize(keys.size(), glm::vec2(0.0f));
+  for (size_t i = 0; i < keys.size(); ++i) {
+    if (keys[i].vt < 0) continue;
+    const float* t = values_[1].at(size_t(keys[i].vt));
+    mesh.uvs[i] = {t[0], t[1]};
+  }
+  values_[1].release();
+  return_free_memory();
+  mesh.normals.resize(keys.size(), glm::vec3(0.0f));
+  bool needs_smoothing = false;
+  for (size_t i = 0; i < keys.size(); ++i) {
+    if (keys[i].vn < 0) {
+      needs_smoothing = true;
+      continue;
+    }
+    const float* n = values_[2].at(size_t(keys[i].vn));
+    mesh.normals[i] = {n[0], n[1], n[2]};
+  }
+  values_[2].release();
+  std::vector<uint32_t> position_index;
+  if (needs_smoothing) {
+    position_index.resize(keys.size());
+    for (size_t v = 0; v < keys.size(); ++v) position_index[v] = uint32_t(keys[v].v);
+  }
+  std::vector<bool> smooth;
+  if (needs_smoothing) {
+    smooth.resize(keys.size());
+    for (size_t v = 0; v < keys.size(); ++v) smooth[v] = keys[v].vn < 0;
+  }
+  table_.release_keys();
+  return_free_memory();
+  mesh.indices.reserve(index_count_);
+  for (std::vector<uint32_t>& piece : index_pieces_) {
+    mesh.indices.insert(mesh.indices.end(), piece.begin(), piece.end());
+    piece = {};
+  }
+  index_pieces_ = {};
+  // Missing normals become smooth normals per OBJ position index, so vertices that share a
+  // position but not a uv still get the same normal.
+  if (needs_smoothing) {
+    auto sums = group_normal_sums(mesh, position_index, position_count);
+    for (size_t v = 0; v < smooth.size(); ++v) {
+      if (smooth[v]) mesh.normals[v] = unit_or_z(sums[position_index[v]]);
+    }
+  }
   return mesh;
+}
+
+Result<Mesh> ObjMerge::finish() {
+  if (index_count_ == 0) return fail(path_, "no faces");
+  // Positive indices may name elements defined further down: checked against the final counts.
+  for (int a = 0; a < 3; ++a) {
+    if (largest_[a].value > int64_t(values_[a].count())) {
+      return fail_at(path_, largest_[a].line,
+                     out_of_range(a, std::to_string(largest_[a].value), values_[a].count()));
+    }
+  }
+  std::vector<std::string> warnings = materials_.take_warnings();
+  Result<std::vector<Material>> materials = materials_.convert(path_, warnings);
+  if (!materials.ok()) return materials.status();
+  Mesh mesh = build_mesh();
+  mesh.materials = std::move(*materials);
+  mesh.warnings = std::move(warnings);
+  return mesh;
+}
+
+// Reads the file in pieces of whole lines. Errors of its own (the byte limit of a pipe, a read
+// error, a NUL byte or an over-long line while looking for a line's end) are kept until every
+// piece before them is merged, which may fail first, as a line-by-line reading would.
+class PieceReader {
+ public:
+  PieceReader(std::FILE* f, const std::string& path, detail::TextLimit limit)
+      : f_(f), path_(path), limit_(limit) {}
+
+  // The next piece into `text`; false at the end of the file or on an error (error_at then says
+  // what, given the lines merged).
+  bool next(std::vector<char>& text);
+  bool at_end() const { return eof_ && carry_.empty(); }
+  bool failed() const { return failed_; }
+  Status error_at(size_t lines_before) const {
+    if (!line_error_) return Status::error(error_);
+    return fail_at(path_, lines_before + 1, error_);
+  }
+
+ private:
+  bool stop(std::string reason, bool at_line) {
+    failed_ = true;
+    line_error_ = at_line;
+    error_ = std::move(reason);
+    return false;
+  }
+
+  std::FILE* f_;
+  const std::string& path_;
+  detail::TextLimit limit_;
+  std::vector<char> carry_;  // the start of a line whose end is not read yet
+  int64_t total_ = 0;
+  bool eof_ = false;
+  bool failed_ = false;
+  bool line_error_ = false;
+  std::string error_;
+};
+
+bool PieceReader::next(std::vector<char>& text) {
+  while (!eof_) {
+    size_t old = carry_.size();
+    carry_.resize(old + kPieceBytes);
+    size_t n = std::fread(carry_.data() + old, 1, kPieceBytes, f_);
+    carry_.resize(old + n);
+    total_ += int64_t(n);
+    // Checked per read, so a pipe or device costs at most one piece past the limit.
+    if (total_ > limit_.max_bytes) {
+      return stop(detail::text_too_large(path_, limit_).message(), false);
+    }
+    if (n < kPieceBytes) {
+      if (std::ferror(f_)) {
+        return stop(path_ + ": cannot read: " + std::strerror(errno), false);
+      }
+      eof_ = true;
+    }
+    const char* fresh = carry_.data() + old;
+    const void* newline = n > 0 ? memrchr(fresh, '\n', n) : nullptr;
+    if (newline) {
+      size_t cut = size_t(static_cast<const char*>(newline) - carry_.data()) + 1;
+      text = std::move(carry_);
+      carry_.assign(text.begin() + std::ptrdiff_t(cut), text.end());
+      text.resize(cut);
+      return true;
+    }
+    if (eof_) break;
+    // No line ends in what was just read: the line goes on, unless it cannot be one.
+    if (std::memchr(fresh, '\0', n)) return stop("NUL byte: not a text file", true);
+    if (carry_.size() > detail::kMaxTextLineBytes) {
+      return stop("line longer than " + detail::byte_limit_text(int64_t(detail::kMaxTextLineBytes)),
+                  true);
+    }
+  }
+  if (carry_.empty()) return false;
+  text = std::move(carry_);  // the last line, without its "\n"
+  carry_ = {};
+  return true;
+}
+
+// Worker threads that parse the pieces they are given, in any order.
+class PieceWorkers {
+ public:
+  explicit PieceWorkers(int count) {
+    try {
+      for (int i = 0; i < count; ++i) threads_.emplace_back([this] { work(); });
+    } catch (...) {  // no thread to be had: stop those that started, then report
+      stop();
+      throw;
+    }
+  }
+  ~PieceWorkers() { stop(); }
+  PieceWorkers(const PieceWorkers&) = delete;
+  PieceWorkers& operator=(const PieceWorkers&) = delete;
+
+  void submit(ObjPiece* piece) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      queue_.push_back(piece);
+    }
+    work_ready_.notify_one();
+  }
+
+  void wait_parsed(const ObjPiece* piece) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    piece_done_.wait(lock, [&] { return piece->parsed; });
+  }
+
+ private:
+  void stop() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+      queue_.clear();
+    }
+    work_ready_.notify_all();
+    for (std::thread& t : threads_) t.join();
+    threads_.clear();
+  }
+
+  void work() {
+    for (;;) {
+      ObjPiece* piece = nullptr;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        work_ready_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+        if (stop_) return;
+        piece = queue_.front();
+        queue_.pop_front();
+      }
+      detail::parse_obj_piece(*piece);
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        piece->parsed = true;
+      }
+      piece_done_.notify_all();
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable work_ready_, piece_done_;
+  std::deque<ObjPiece*> queue_;
+  bool stop_ = false;
+  std::vector<std::thread> threads_;
+};
+
+int parse_threads() {
+  unsigned n = std::thread::hardware_concurrency();
+  return int(std::clamp(n, 1u, 16u));
+}
+
+// Pieces read, parsed by the workers and merged in order, at most kWindow at a time.
+Status parse_in_parallel(PieceReader& reader, std::vector<char> first, ObjMerge& merge) {
+  int threads = parse_threads();
+  const size_t window_limit = size_t(threads) + 1;
+  std::deque<std::unique_ptr<ObjPiece>> window;  // declared first: outlives the workers
+  PieceWorkers workers(threads);
+  auto submit = [&](std::vector<char>&& text) {
+    window.push_back(std::make_unique<ObjPiece>());
+    window.back()->text = std::move(text);
+    workers.submit(window.back().get());
+  };
+  submit(std::move(first));
+  for (;;) {
+    while (window.size() < window_limit) {
+      std::vector<char> text;
+      if (!reader.next(text)) break;
+      submit(std::move(text));
+    }
+    if (window.empty()) return {};
+    workers.wait_parsed(window.front().get());
+    Status s = merge.merge(*window.front());
+    window.pop_front();
+    if (!s.ok()) return s;
+  }
 }
 
 }  // namespace
@@ -507,12 +607,24 @@ Result<Mesh> ObjParser::finish() {
 namespace detail {
 
 Result<Mesh> load_obj(const std::string& path, int64_t max_obj_bytes, int64_t max_mtl_bytes) {
-  ObjParser parser(path, max_mtl_bytes);
-  Status read =
-      read_lines(path, {max_obj_bytes, "OBJ files"},
-                 [&](std::string_view line, size_t number) { return parser.line(line, number); });
-  if (!read.ok()) return read;
-  return parser.finish();
+  TextLimit limit{max_obj_bytes, "OBJ files"};
+  FilePtr file;
+  if (Status s = open_text_file(path, limit, file); !s.ok()) return s;
+  PieceReader reader(file.get(), path, limit);
+  ObjMerge merge(path, max_mtl_bytes);
+  std::vector<char> first;
+  if (reader.next(first)) {
+    if (reader.at_end()) {  // one piece: no threads
+      ObjPiece piece;
+      piece.text = std::move(first);
+      parse_obj_piece(piece);
+      if (Status s = merge.merge(piece); !s.ok()) return s;
+    } else if (Status s = parse_in_parallel(reader, std::move(first), merge); !s.ok()) {
+      return s;
+    }
+  }
+  if (reader.failed()) return reader.error_at(merge.lines());
+  return merge.finish();
 }
 
 }  // namespace detail

@@ -14,32 +14,30 @@
 namespace softrast::detail {
 namespace {
 
-struct FileCloser {
-  void operator()(std::FILE* f) const { std::fclose(f); }
-};
-using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
-
 constexpr size_t kReadBlock = size_t(1) << 16;
 
 Status fail(const std::string& path, const std::string& reason) {
   return Status::error(path + ": " + reason);
 }
 
-Status too_large(const std::string& path, TextLimit limit) {
+}  // namespace
+
+Status text_too_large(const std::string& path, TextLimit limit) {
   return fail(path, "file is larger than " + byte_limit_text(limit.max_bytes) + ", the limit for " +
                         limit.kind);
 }
 
-// Opens `path` for reading and refuses folders and regular files over the limit up front.
-Status open_capped(const std::string& path, TextLimit limit, FilePtr& f) {
+Status open_text_file(const std::string& path, TextLimit limit, FilePtr& f) {
   f.reset(std::fopen(path.c_str(), "rb"));
   if (!f) return fail(path, std::string("cannot open: ") + std::strerror(errno));
   struct stat info {};
   if (fstat(fileno(f.get()), &info) != 0) return {};  // found out while reading, if at all
   if (S_ISDIR(info.st_mode)) return fail(path, "is a directory");
-  if (S_ISREG(info.st_mode) && info.st_size > limit.max_bytes) return too_large(path, limit);
+  if (S_ISREG(info.st_mode) && info.st_size > limit.max_bytes) return text_too_large(path, limit);
   return {};
 }
+
+namespace {
 
 // Splits blocks into lines; a line split across blocks is gathered in `pending_`.
 class LineSplitter {
@@ -110,7 +108,7 @@ std::string byte_limit_text(int64_t bytes) {
 
 Status read_lines(const std::string& path, TextLimit limit, const LineFn& fn) {
   FilePtr f;
-  if (Status s = open_capped(path, limit, f); !s.ok()) return s;
+  if (Status s = open_text_file(path, limit, f); !s.ok()) return s;
   LineSplitter lines(path, fn);
   std::vector<char> block(kReadBlock);
   int64_t total = 0;
@@ -119,7 +117,7 @@ Status read_lines(const std::string& path, TextLimit limit, const LineFn& fn) {
     if (n == 0) break;
     total += int64_t(n);
     // Checked per block, so a pipe or device costs at most one block past the limit.
-    if (total > limit.max_bytes) return too_large(path, limit);
+    if (total > limit.max_bytes) return text_too_large(path, limit);
     if (Status s = lines.feed(block.data(), n); !s.ok()) return s;
   }
   if (std::ferror(f.get())) return fail(path, std::string("cannot read: ") + std::strerror(errno));

@@ -4,7 +4,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -30,6 +32,18 @@ struct TextLimit {
 // pipes and devices are cut off while reading), a NUL byte (not a text file: /dev/zero fails in
 // the first block) and a line longer than kMaxTextLineBytes.
 Status read_lines(const std::string& path, TextLimit limit, const LineFn& fn);
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
+
+// Opens `path` for reading; refuses (naming the file) one that cannot be opened, a folder and a
+// regular file over limit.max_bytes. Pipes and devices must be cut off by the reader.
+Status open_text_file(const std::string& path, TextLimit limit, FilePtr& f);
+
+// "path: file is larger than 2 GiB, the limit for OBJ files".
+Status text_too_large(const std::string& path, TextLimit limit);
 
 // "64 MiB", "2 GiB": a byte limit for messages.
 std::string byte_limit_text(int64_t bytes);

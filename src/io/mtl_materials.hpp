@@ -1,0 +1,54 @@
+// io/mtl_materials.hpp: the MTL libraries an OBJ file names, read through tinyobjloader's
+// LoadMtl after their numbers are checked, and turned into softrast materials with textures.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <tiny_obj_loader.h>
+
+#include "softrast/mesh.hpp"
+
+namespace softrast::detail {
+
+// The materials of every MTL library the OBJ names, relative to the OBJ's folder, each with its
+// MTL's folder (texture paths are relative to it) and whether it had a Kd. A missing MTL is not an
+// error but a warning: the OBJ then has no materials from it, as with other loaders.
+class ObjMaterials {
+ public:
+  ObjMaterials(std::filesystem::path obj_dir, int64_t max_mtl_bytes)
+      : obj_dir_(std::move(obj_dir)), max_bytes_(max_mtl_bytes) {}
+
+  // Reads library `name` once (later mentions are ignored). `obj_line` is where the OBJ names it,
+  // for the warning if it is missing; an MTL that exists but cannot be read, is too large or has
+  // a number tinyobj would overflow on is an error naming the MTL file and line.
+  Status load_library(const std::string& name, const std::string& obj_path, size_t obj_line);
+
+  // The material's index, or -1 (the default material) for a name no library defined.
+  int id(const std::string& name) const {
+    auto it = ids_.find(name);
+    return it == ids_.end() ? -1 : it->second;
+  }
+
+  // The materials with their textures; a map_Kd that cannot be loaded adds a warning instead.
+  Result<std::vector<Material>> convert(const std::string& path,
+                                        std::vector<std::string>& warnings) const;
+
+  std::vector<std::string> take_warnings() { return std::move(warnings_); }
+
+ private:
+  std::filesystem::path obj_dir_;
+  int64_t max_bytes_;
+  std::set<std::string> loaded_;
+  std::map<std::string, int> ids_;
+  std::vector<tinyobj::material_t> all_;
+  std::vector<std::filesystem::path> dirs_;
+  std::vector<bool> has_kd_;
+  std::vector<std::string> warnings_;
+};
+
+}  // namespace softrast::detail
