@@ -329,6 +329,55 @@ TEST_F(CliTest, DefaultLightIsAHeadlight) {
   }
 }
 
+// The headlight lights a sphere the same from six directions: seen from the front, back, left,
+// right, top and bottom, the sphere's mean brightness agrees within 2 % and its brightest pixel
+// is up and to the right of the centre every time: (0.3, 0.5, 0.8) in the camera's frame, x to the
+// right, y up, comes from the viewer's upper right.
+TEST_F(CliTest, HeadlightLightsASphereEquallyFromSixDirections) {
+  std::string obj;
+  const int kSlices = 48, kStacks = 32;
+  for (int j = 0; j <= kStacks; ++j) {
+    for (int i = 0; i <= kSlices; ++i) {
+      float theta = 3.14159265f * float(j) / kStacks, phi = 6.2831853f * float(i) / kSlices;
+      obj += "v " + std::to_string(std::sin(theta) * std::cos(phi)) + " " +
+             std::to_string(std::cos(theta)) + " " +
+             std::to_string(std::sin(theta) * std::sin(phi)) + "\n";
+    }
+  }
+  for (int j = 0; j < kStacks; ++j) {
+    for (int i = 0; i < kSlices; ++i) {
+      int a = j * (kSlices + 1) + i + 1, b = a + kSlices + 1;
+      obj += "f " + std::to_string(a) + " " + std::to_string(a + 1) + " " + std::to_string(b) +
+             "\nf " + std::to_string(a + 1) + " " + std::to_string(b + 1) + " " +
+             std::to_string(b) + "\n";
+    }
+  }
+  write("sphere.obj", obj);
+  std::vector<double> means;
+  for (const char* view : {"front", "back", "left", "right", "top", "bottom"}) {
+    CliRun r = run(std::string("sphere.obj --size 96x96 --shader gouraud --view ") +
+                   view + " -o lit_" + view + ".png");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    Image image = load(std::string("lit_") + view + ".png", 96, 96);
+    int clear = pixel(image, 0, 0)[0];
+    double sum = 0;
+    int count = 0, best = -1, best_x = 0, best_y = 0;
+    for (int y = 0; y < 96; ++y) {
+      for (int x = 0; x < 96; ++x) {
+        int red = pixel(image, x, y)[0];
+        if (red == clear) continue;
+        sum += red, ++count;
+        if (red > best) best = red, best_x = x, best_y = y;
+      }
+    }
+    ASSERT_GT(count, 96 * 96 / 3) << view;
+    means.push_back(sum / count);
+    EXPECT_GT(best_x, 48) << view << ": the brightest pixel is right of the centre";
+    EXPECT_LT(best_y, 48) << view << ": the brightest pixel is above the centre";
+  }
+  for (double m : means) EXPECT_NEAR(m, means[0], 0.02 * means[0]);
+}
+
 TEST_F(CliTest, HelpMentionsEveryFlag) {
   for (const char* args : {"--help", "render --help", "-h"}) {
     CliRun r = run(args);

@@ -82,7 +82,7 @@ void define_shading_flags(CLI::App& app, RawArgs& a) {
       ->type_name("R,G,B");
   app.add_option("--light", a.light,
                  "Direction towards the light, fixed in world space (default: a headlight, "
-                 "0.3,0.5,0.8 in the camera's frame, so any view is lit from its upper left)")
+                 "0.3,0.5,0.8 in the camera's frame, so any view is lit from its upper right)")
       ->type_name("X,Y,Z");
   app.add_option("--ambient", a.ambient,
                  "Ambient light of gouraud and phong, 0 to 1 (default 0.15)")
