@@ -282,30 +282,6 @@ TEST(TextureTest, BilinearHalfwayAverages) {
   EXPECT_NEAR(red_at(t, Filter::kBilinear, Wrap::kMirroredRepeat, {0.0f, 0.25f}), 30.0f, 1e-4f);
 }
 
-// Weights have 8 fractional bits (as GPUs and llvmpipe filter) and the lerps are in integers:
-// between a black and a white texel, a coordinate at fraction f gives floor(255 * floor(256 f) /
-// 256) (the float formula would give 255 f, up to one step more). Equal texels stay exact.
-TEST(TextureTest, BilinearWeightsHaveEightFractionalBits) {
-  Image image(2, 1);
-  image.pixel(0, 0)[0] = 0, image.pixel(1, 0)[0] = 255;
-  image.pixel(0, 0)[1] = 77, image.pixel(1, 0)[1] = 77;
-  Texture t = Texture::from_image(image);
-  Sampler s{Filter::kBilinear, Wrap::kClampToEdge, Wrap::kClampToEdge};
-  int steps_seen = 0;
-  for (int k = 0; k <= 1000; ++k) {
-    double f = k / 1000.0;  // from the centre of texel 0 to the centre of texel 1
-    float u = float((0.5 + f) / 2.0);
-    glm::vec4 c = t.sample(s, {u, 0.5f});
-    float scaled = (u * 2.0f - 0.5f) * 256.0f;  // the coordinate in 1/256 texel, as computed
-    int weight = std::min(256, int(std::floor(scaled)));
-    int expected = (255 * weight) >> 8;
-    ASSERT_EQ(c.r, float(expected) * (1.0f / 255.0f)) << "u " << u;
-    ASSERT_EQ(c.g, 77.0f * (1.0f / 255.0f)) << "equal texels blend to themselves";
-    steps_seen += int(std::floor(f * 255.0) != expected);
-  }
-  EXPECT_GT(steps_seen, 0) << "the float formula would have given the same values";
-}
-
 TEST(TextureTest, WrapModesOutsideUnitSquare) {
   Texture t = small_texture();
   // Rounded: 30 / 255 * 255 is not exactly 30 in float.

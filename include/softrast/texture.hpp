@@ -170,46 +170,18 @@ inline glm::vec4 Texture::sample_nearest(const Sampler& s, glm::vec2 uv, int lev
   return level_texel(l, i, j);
 }
 
-// The bilinear weights have 8 fractional bits, as GPUs and llvmpipe filter: a coordinate in
-// texels (shifted by half a texel) splits into texel floor(x) and weight floor(256 x) & 255.
-// NaN and |x| >= 1e9 / 256 texels give texel 0, weight 0. The shift is a floor division.
-inline int texel_floor_fx8(float x, int& weight) {
-  float s = x * 256.0f;
-  if (!(s > -1.0e9f && s < 1.0e9f)) {
-    weight = 0;
-    return 0;
-  }
-  int i = static_cast<int>(s);  // truncates towards zero
-  if (float(i) > s) --i;
-  weight = i & 255;
-  return i >> 8;
-}
-
-// a + (b - a) * w / 256 per channel, in integers: (a (256 - w) + b w) >> 8 (exact when a == b).
-inline int lerp_fx8(int a, int b, int w) {
-  return (a * (256 - w) + b * w) >> 8;
-}
-
 inline glm::vec4 Texture::sample_bilinear(const Sampler& s, glm::vec2 uv, int level) const {
   // Texel centres sit at half-integers, so shift by half a texel before splitting into the
   // integer texel and the fractional weight (GL_LINEAR).
   const MipLevel& l = levels_[size_t(level)];
-  int wx, wy;
-  int x0 = texel_floor_fx8(uv.x * float(l.width) - 0.5f, wx);
-  int y0 = texel_floor_fx8(uv.y * float(l.height) - 0.5f, wy);
+  float fx, fy;
+  int x0 = texel_floor(uv.x * float(l.width) - 0.5f, fx);
+  int y0 = texel_floor(uv.y * float(l.height) - 0.5f, fy);
   int i0 = wrap(s.wrap_u, x0, l.width), i1 = wrap(s.wrap_u, x0 + 1, l.width);
   int j0 = wrap(s.wrap_v, y0, l.height), j1 = wrap(s.wrap_v, y0 + 1, l.height);
-  auto at = [&](int i, int j) {
-    return &texels_[(l.offset + size_t(j) * size_t(l.width) + size_t(i)) * 4];
-  };
-  const uint8_t *t00 = at(i0, j0), *t10 = at(i1, j0), *t01 = at(i0, j1), *t11 = at(i1, j1);
-  constexpr float k = 1.0f / 255.0f;
-  glm::vec4 out;
-  for (int c = 0; c < 4; ++c) {
-    int bottom = lerp_fx8(t00[c], t10[c], wx), top = lerp_fx8(t01[c], t11[c], wx);
-    out[c] = float(lerp_fx8(bottom, top, wy)) * k;
-  }
-  return out;
+  glm::vec4 bottom = level_texel(l, i0, j0) * (1.0f - fx) + level_texel(l, i1, j0) * fx;
+  glm::vec4 top = level_texel(l, i0, j1) * (1.0f - fx) + level_texel(l, i1, j1) * fx;
+  return bottom * (1.0f - fy) + top * fy;
 }
 
 }  // namespace softrast

@@ -46,52 +46,18 @@ SOFTRAST_SIMD_INLINE simd::Int<N> wrap_texel(Wrap mode, const simd::Int<N>& i,
   return r;
 }
 
-// texel_floor_fx8 (texture.hpp) for 16 lanes. The floor division by 256 is a logical shift of
-// i + 2^30 (i is within +-1e9 < 2^30, so the sum is not negative).
-template <int N>
-SOFTRAST_SIMD_INLINE simd::Int<N> texel_floor_fx8(const simd::Float<N>& x, simd::Int<N>& weight) {
-  using F = simd::Float<N>;
-  using I = simd::Int<N>;
-  F s = x * F(256.0f);
-  I ok = (s > F(-1.0e9f)) & (s < F(1.0e9f));
-  F ss = simd::select(ok, s, F(0.0f));
-  I i = simd::to_int(ss);
-  i = i + (simd::to_float(i) > ss);
-  weight = i & I(255);
-  return ((i + I(1 << 30)) >> 8) - I(1 << 22);
-}
-
-// lerp_fx8 (texture.hpp) on the four channels of packed RGBA8 texels: red and blue in one 32-bit
-// lane, green and alpha in another; a channel's sum is below 2^16, so it never carries into the
-// next.
-template <int N>
-SOFTRAST_SIMD_INLINE simd::Int<N> lerp_rgba8(const simd::Int<N>& a, const simd::Int<N>& b,
-                                             const simd::Int<N>& w) {
-  using I = simd::Int<N>;
-  const I mask(0x00ff00ff);
-  I wa = I(256) - w;
-  I rb = (((a & mask) * wa + (b & mask) * w) >> 8) & mask;
-  I ga = ((((a >> 8) & mask) * wa + ((b >> 8) & mask) * w) >> 8) & mask;
-  return rb | ga << 8;
-}
-
-// Packed RGBA8 to four floats in [0, 1], as Texture::texel converts.
-template <int N>
-SOFTRAST_SIMD_INLINE simd::Vec4<N> unpack_texel(const simd::Int<N>& texel) {
-  using F = simd::Float<N>;
-  const F k(1.0f / 255.0f);
-  simd::Int<N> byte(0xff);
-  return {simd::to_float(texel & byte) * k, simd::to_float((texel >> 8) & byte) * k,
-          simd::to_float((texel >> 16) & byte) * k, simd::to_float(texel >> 24) * k};
-}
-
 // Texel (i, j) of the level whose size and first texel are (w, h, offset), lane by lane.
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> fetch(const Texture& t, const simd::Int<N>& i,
                                          const simd::Int<N>& j, const simd::Int<N>& w,
                                          const simd::Int<N>& offset) {
-  return unpack_texel<N>(
-      simd::gather<N>(reinterpret_cast<const int32_t*>(t.texels()), offset + j * w + i));
+  using F = simd::Float<N>;
+  simd::Int<N> texel =
+      simd::gather<N>(reinterpret_cast<const int32_t*>(t.texels()), offset + j * w + i);
+  const F k(1.0f / 255.0f);
+  simd::Int<N> byte(0xff);
+  return {simd::to_float(texel & byte) * k, simd::to_float((texel >> 8) & byte) * k,
+          simd::to_float((texel >> 16) & byte) * k, simd::to_float(texel >> 24) * k};
 }
 
 template <int N>
@@ -117,21 +83,18 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_level(const Texture& t, const Sampler&
     I j = wrap_texel<N>(s.wrap_v, texel_floor<N>(uv.y * hf, fy), h, pow2_v);
     return fetch<N>(t, i, j, w, offset);
   }
-  // Texel centres sit at half-integers: shift by half a texel, then split (GL_LINEAR), with
-  // 8-bit weights and the lerps in integers, two channels per 32-bit lane.
-  I wx, wy;
-  I x0 = texel_floor_fx8<N>(uv.x * wf - F(0.5f), wx);
-  I y0 = texel_floor_fx8<N>(uv.y * hf - F(0.5f), wy);
+  // Texel centres sit at half-integers: shift by half a texel, then split (GL_LINEAR).
+  I x0 = texel_floor<N>(uv.x * wf - F(0.5f), fx);
+  I y0 = texel_floor<N>(uv.y * hf - F(0.5f), fy);
   I one(1);
   I i0 = wrap_texel<N>(s.wrap_u, x0, w, pow2_u);
   I i1 = wrap_texel<N>(s.wrap_u, x0 + one, w, pow2_u);
-  I row0 = offset + wrap_texel<N>(s.wrap_v, y0, h, pow2_v) * w;
-  I row1 = offset + wrap_texel<N>(s.wrap_v, y0 + one, h, pow2_v) * w;
-  const int32_t* texels = reinterpret_cast<const int32_t*>(t.texels());
-  I bottom =
-      lerp_rgba8<N>(simd::gather<N>(texels, row0 + i0), simd::gather<N>(texels, row0 + i1), wx);
-  I top = lerp_rgba8<N>(simd::gather<N>(texels, row1 + i0), simd::gather<N>(texels, row1 + i1), wx);
-  return unpack_texel<N>(lerp_rgba8<N>(bottom, top, wy));
+  I j0 = wrap_texel<N>(s.wrap_v, y0, h, pow2_v);
+  I j1 = wrap_texel<N>(s.wrap_v, y0 + one, h, pow2_v);
+  simd::Vec4<N> bottom =
+      lerp<N>(fetch<N>(t, i0, j0, w, offset), fetch<N>(t, i1, j0, w, offset), fx);
+  simd::Vec4<N> top = lerp<N>(fetch<N>(t, i0, j1, w, offset), fetch<N>(t, i1, j1, w, offset), fx);
+  return lerp<N>(bottom, top, fy);
 }
 
 // fast_log2 (texture.hpp) for 16 lanes, the same operations.
