@@ -17,10 +17,16 @@ struct FuzzFailure : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Throws FuzzFailure(message) when `ok` is false.
-inline void require(bool ok, const std::string& message) {
-  if (!ok) throw FuzzFailure(message);
-}
+}  // namespace softrast::fuzz
+
+// Throws FuzzFailure(message) when `ok` is false; the message is built only then (the checks run
+// per pixel on every input).
+#define SOFTRAST_FUZZ_REQUIRE(ok, message)                                    \
+  do {                                                                        \
+    if (!(ok)) throw ::softrast::fuzz::FuzzFailure(std::string(message));     \
+  } while (0)
+
+namespace softrast::fuzz {
 
 // OBJ, with an MTL and a texture after separator lines (see obj_fuzz.cpp): load_obj through
 // files in a private temporary folder; a loaded mesh must be valid (indices in range, finite

@@ -49,17 +49,17 @@ std::string_view take_until(std::string_view& rest, std::string_view separator) 
 }
 
 void check_mesh(const Mesh& mesh) {
-  require(!mesh.indices.empty() && mesh.indices.size() % 3 == 0, "index count not 3n > 0");
-  require(mesh.normals.size() == mesh.positions.size(), "normals and positions differ in count");
-  require(mesh.uvs.size() == mesh.positions.size(), "uvs and positions differ in count");
-  for (uint32_t i : mesh.indices) require(i < mesh.positions.size(), "index out of range");
+  SOFTRAST_FUZZ_REQUIRE(!mesh.indices.empty() && mesh.indices.size() % 3 == 0, "index count not 3n > 0");
+  SOFTRAST_FUZZ_REQUIRE(mesh.normals.size() == mesh.positions.size(), "normals and positions differ in count");
+  SOFTRAST_FUZZ_REQUIRE(mesh.uvs.size() == mesh.positions.size(), "uvs and positions differ in count");
+  for (uint32_t i : mesh.indices) SOFTRAST_FUZZ_REQUIRE(i < mesh.positions.size(), "index out of range");
   for (const glm::vec3& p : mesh.positions) {
-    require(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), "non-finite position");
+    SOFTRAST_FUZZ_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), "non-finite position");
   }
   for (const SubMesh& s : mesh.submeshes) {
-    require(size_t(s.first_index) + s.index_count <= mesh.indices.size(), "submesh past indices");
-    require(s.index_count % 3 == 0, "submesh not whole triangles");
-    require(s.material >= -1 && s.material < int(mesh.materials.size()), "bad material index");
+    SOFTRAST_FUZZ_REQUIRE(size_t(s.first_index) + s.index_count <= mesh.indices.size(), "submesh past indices");
+    SOFTRAST_FUZZ_REQUIRE(s.index_count % 3 == 0, "submesh not whole triangles");
+    SOFTRAST_FUZZ_REQUIRE(s.material >= -1 && s.material < int(mesh.materials.size()), "bad material index");
   }
 }
 
@@ -76,8 +76,8 @@ int fuzz_obj(const uint8_t* data, size_t size) {
   Result<Mesh> mesh = load_obj((folder.path / "model.obj").string());
   if (!mesh) {
     const std::string& m = mesh.status().message();
-    require(!m.empty(), "load_obj failed without a message");
-    require(m.find("model.") != std::string::npos || m.find("tex.png") != std::string::npos,
+    SOFTRAST_FUZZ_REQUIRE(!m.empty(), "load_obj failed without a message");
+    SOFTRAST_FUZZ_REQUIRE(m.find("model.") != std::string::npos || m.find("tex.png") != std::string::npos,
             "error does not name a file: " + m);
     return 0;
   }
