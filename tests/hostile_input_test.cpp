@@ -19,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -360,6 +361,8 @@ TEST_F(HostileInput, EveryCaseFailsCleanlyOrRendersCorrectly) {
   std::vector<Case> cases = hostile_cases();
   ASSERT_GT(cases.size(), 150u);
   for (const Case& c : cases) run(c);
+  RecordProperty("cases", int(cases.size()));
+  std::printf("hostile inputs: %zu cases\n", cases.size());
 }
 
 // The valid inputs render what they describe: the CRLF OBJ gives the LF OBJ's image byte for
