@@ -75,17 +75,19 @@ INSTANTIATE_TEST_SUITE_P(Targets, FuzzReplay, testing::ValuesIn(kTargets),
                            return std::string(info.param.name);
                          });
 
-// The geometry target's checks are not vacuous: a triangle covering pixels passes them, and the
-// same bytes with one vertex moved by 1/256 pixel still pass (the oracle follows the input).
+// The geometry target's checks are not vacuous: a right triangle whose edges run through pixel
+// centres (window (6.5, 6.5), (6.5, 26.5), (26.5, 6.5): grid x = (window - 16) * 256) passes
+// them, and a fill rule that kept the samples on its right or bottom edges would not.
 TEST(FuzzReplay, GeometryChecksRunOnAValidTriangle) {
   std::vector<uint8_t> input = {0x04, 0x00};  // grid vertices, full scissor
-  auto vertex = [&](int x, int y) {
+  auto vertex = [&](double wx, double wy) {
+    int x = int((wx - 16.0) * 256.0), y = int((wy - 16.0) * 256.0);
     input.insert(input.end(), {uint8_t(x & 255), uint8_t(x >> 8 & 255), uint8_t(y & 255),
                                uint8_t(y >> 8 & 255), 0, 0, 0, 0});
   };
-  vertex(-10 * 256, -10 * 256);
-  vertex(-10 * 256, 10 * 256 + 1);
-  vertex(10 * 256, -10 * 256);
+  vertex(6.5, 6.5);
+  vertex(6.5, 26.5);
+  vertex(26.5, 6.5);
   EXPECT_NO_THROW(fuzz_geometry(input.data(), input.size()));
 }
 
