@@ -34,11 +34,14 @@ std::vector<std::string> split_arguments(const uint8_t* data, size_t size) {
 }
 
 void check_spec(const cli::JobSpec& spec) {
-  SOFTRAST_FUZZ_REQUIRE(spec.width >= 1 && spec.width <= kMaxImageSize, "width outside 1..kMaxImageSize");
-  SOFTRAST_FUZZ_REQUIRE(spec.height >= 1 && spec.height <= kMaxImageSize, "height outside 1..kMaxImageSize");
+  SOFTRAST_FUZZ_REQUIRE(spec.width >= 1 && spec.width <= kMaxImageSize,
+                        "width outside 1..kMaxImageSize");
+  SOFTRAST_FUZZ_REQUIRE(spec.height >= 1 && spec.height <= kMaxImageSize,
+                        "height outside 1..kMaxImageSize");
   SOFTRAST_FUZZ_REQUIRE(spec.frames >= 0, "negative frame count");
   SOFTRAST_FUZZ_REQUIRE(spec.output || spec.frames > 0, "no output and no benchmark");
-  SOFTRAST_FUZZ_REQUIRE(spec.options.alpha >= 0.0f && spec.options.alpha <= 1.0f, "alpha outside [0, 1]");
+  SOFTRAST_FUZZ_REQUIRE(spec.options.alpha >= 0.0f && spec.options.alpha <= 1.0f,
+                        "alpha outside [0, 1]");
   SOFTRAST_FUZZ_REQUIRE(spec.options.state.threads >= 0, "negative thread count");
 }
 

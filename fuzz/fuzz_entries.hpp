@@ -21,9 +21,9 @@ struct FuzzFailure : std::runtime_error {
 
 // Throws FuzzFailure(message) when `ok` is false; the message is built only then (the checks run
 // per pixel on every input).
-#define SOFTRAST_FUZZ_REQUIRE(ok, message)                                    \
-  do {                                                                        \
-    if (!(ok)) throw ::softrast::fuzz::FuzzFailure(std::string(message));     \
+#define SOFTRAST_FUZZ_REQUIRE(ok, message)                                \
+  do {                                                                    \
+    if (!(ok)) throw ::softrast::fuzz::FuzzFailure(std::string(message)); \
   } while (0)
 
 namespace softrast::fuzz {

@@ -202,11 +202,12 @@ void check_window_triangle(const Input& in, const WindowVertex& a, const WindowV
       for (int x = s.x0; x < s.x1; ++x) {
         int want = test::rule_covers_pixel(t, x, y) ? 1 : 0;
         int got = rec.hits[y * kSize + x];
-        SOFTRAST_FUZZ_REQUIRE(got == want, std::string(name) + "covers " + std::to_string(got) +
-                                 " times, the rule " + std::to_string(want) + where(x, y) +
-                                 " (triangle " + std::to_string(a.x) + "," + std::to_string(a.y) +
-                                 " " + std::to_string(b.x) + "," + std::to_string(b.y) + " " +
-                                 std::to_string(c.x) + "," + std::to_string(c.y) + " /256)");
+        SOFTRAST_FUZZ_REQUIRE(
+            got == want, std::string(name) + "covers " + std::to_string(got) + " times, the rule " +
+                             std::to_string(want) + where(x, y) + " (triangle " +
+                             std::to_string(a.x) + "," + std::to_string(a.y) + " " +
+                             std::to_string(b.x) + "," + std::to_string(b.y) + " " +
+                             std::to_string(c.x) + "," + std::to_string(c.y) + " /256)");
       }
     }
   }
@@ -243,9 +244,9 @@ void check_triangle(const Input& in, uint32_t t, int* all) {
   for (int y = 0; y < kSize; ++y) {
     for (int x = 0; x < kSize; ++x) {
       int got = int(fb.color_at(x, y) & 0xff), want = std::min(oracle[y * kSize + x], 255);
-      SOFTRAST_FUZZ_REQUIRE(got == want, "draw() hits " + std::to_string(got) + " times, the oracle " +
-                               std::to_string(want) + where(x, y) + " (triangle " +
-                               std::to_string(t) + ")");
+      SOFTRAST_FUZZ_REQUIRE(got == want, "draw() hits " + std::to_string(got) +
+                                             " times, the oracle " + std::to_string(want) +
+                                             where(x, y) + " (triangle " + std::to_string(t) + ")");
       all[y * kSize + x] += oracle[y * kSize + x];
     }
   }
@@ -274,11 +275,12 @@ void check_paths_agree(const Input& in, const int* covered) {
   for (int y = 0; y < kSize; ++y) {
     for (int x = 0; x < kSize; ++x) {
       float dr = ref.depth_at(x, y), df = fast.depth_at(x, y);
-      SOFTRAST_FUZZ_REQUIRE(ref.color_at(x, y) == fast.color_at(x, y) && std::memcmp(&dr, &df, 4) == 0,
-              "reference and binned paths differ" + where(x, y));
+      SOFTRAST_FUZZ_REQUIRE(
+          ref.color_at(x, y) == fast.color_at(x, y) && std::memcmp(&dr, &df, 4) == 0,
+          "reference and binned paths differ" + where(x, y));
       bool changed = ref.color_at(x, y) != clear.color_at(x, y) || dr != clear.depth_at(x, y);
       SOFTRAST_FUZZ_REQUIRE(!changed || covered[y * kSize + x] > 0,
-              "a pixel no triangle covers was written" + where(x, y));
+                            "a pixel no triangle covers was written" + where(x, y));
     }
   }
 }

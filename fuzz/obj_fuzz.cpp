@@ -49,17 +49,24 @@ std::string_view take_until(std::string_view& rest, std::string_view separator) 
 }
 
 void check_mesh(const Mesh& mesh) {
-  SOFTRAST_FUZZ_REQUIRE(!mesh.indices.empty() && mesh.indices.size() % 3 == 0, "index count not 3n > 0");
-  SOFTRAST_FUZZ_REQUIRE(mesh.normals.size() == mesh.positions.size(), "normals and positions differ in count");
-  SOFTRAST_FUZZ_REQUIRE(mesh.uvs.size() == mesh.positions.size(), "uvs and positions differ in count");
-  for (uint32_t i : mesh.indices) SOFTRAST_FUZZ_REQUIRE(i < mesh.positions.size(), "index out of range");
+  SOFTRAST_FUZZ_REQUIRE(!mesh.indices.empty() && mesh.indices.size() % 3 == 0,
+                        "index count not 3n > 0");
+  SOFTRAST_FUZZ_REQUIRE(mesh.normals.size() == mesh.positions.size(),
+                        "normals and positions differ in count");
+  SOFTRAST_FUZZ_REQUIRE(mesh.uvs.size() == mesh.positions.size(),
+                        "uvs and positions differ in count");
+  for (uint32_t i : mesh.indices)
+    SOFTRAST_FUZZ_REQUIRE(i < mesh.positions.size(), "index out of range");
   for (const glm::vec3& p : mesh.positions) {
-    SOFTRAST_FUZZ_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), "non-finite position");
+    SOFTRAST_FUZZ_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z),
+                          "non-finite position");
   }
   for (const SubMesh& s : mesh.submeshes) {
-    SOFTRAST_FUZZ_REQUIRE(size_t(s.first_index) + s.index_count <= mesh.indices.size(), "submesh past indices");
+    SOFTRAST_FUZZ_REQUIRE(size_t(s.first_index) + s.index_count <= mesh.indices.size(),
+                          "submesh past indices");
     SOFTRAST_FUZZ_REQUIRE(s.index_count % 3 == 0, "submesh not whole triangles");
-    SOFTRAST_FUZZ_REQUIRE(s.material >= -1 && s.material < int(mesh.materials.size()), "bad material index");
+    SOFTRAST_FUZZ_REQUIRE(s.material >= -1 && s.material < int(mesh.materials.size()),
+                          "bad material index");
   }
 }
 
@@ -80,8 +87,9 @@ int fuzz_obj(const uint8_t* data, size_t size) {
     // "path: reason" or "path:line: reason", the path as the user or the file gave it (the OBJ,
     // or an MTL or texture path from it, relative to its folder or absolute: "mtllib /").
     size_t colon = m.find(':');
-    SOFTRAST_FUZZ_REQUIRE(colon != std::string::npos && colon > 0 && m.find(": ") != std::string::npos,
-                          "error does not start with a file name: " + m);
+    SOFTRAST_FUZZ_REQUIRE(
+        colon != std::string::npos && colon > 0 && m.find(": ") != std::string::npos,
+        "error does not start with a file name: " + m);
     return 0;
   }
   check_mesh(*mesh);

@@ -52,9 +52,8 @@ size_t replay(const Target& target, const fs::path& dir) {
     try {
       target.entry(bytes.data(), bytes.size());
     } catch (const FuzzFailure& e) {
-      ADD_FAILURE() << file.string() << ": " << e.what()
-                    << "\n(reproduce: build/fuzz/fuzz/fuzz_" << target.name << " " << file.string()
-                    << ")";
+      ADD_FAILURE() << file.string() << ": " << e.what() << "\n(reproduce: build/fuzz/fuzz/fuzz_"
+                    << target.name << " " << file.string() << ")";
     }
   }
   return files.size();

@@ -110,7 +110,8 @@ Outcome run_cli(const fs::path& dir, const fs::path& logs, const std::vector<std
 // Files.
 
 // A triangle facing +z with uvs; framed automatically it fills much of a square image.
-const Bytes kTriangleObj = "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0.5 1\nf 1/1 2/2 3/3\n";
+const Bytes kTriangleObj =
+    "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0.5 1\nf 1/1 2/2 3/3\n";
 
 Bytes be32(uint32_t v) {
   return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
@@ -118,7 +119,8 @@ Bytes be32(uint32_t v) {
 
 Bytes png_chunk(const std::string& type, const Bytes& data) {
   Bytes body = type + data;
-  uint32_t crc = uint32_t(::crc32(0, reinterpret_cast<const Bytef*>(body.data()), uInt(body.size())));
+  uint32_t crc =
+      uint32_t(::crc32(0, reinterpret_cast<const Bytef*>(body.data()), uInt(body.size())));
   return be32(uint32_t(data.size())) + body + be32(crc);
 }
 
@@ -146,7 +148,8 @@ Bytes make_png(uint32_t width, uint32_t height, const Bytes* pixels) {
 }
 
 // 2x2 texture: red, green / blue, white (rows top first).
-const Bytes kPixels2x2 = Bytes("\xff\x00\x00\xff\x00\xff\x00\xff\x00\x00\xff\xff\xff\xff\xff\xff", 16);
+const Bytes kPixels2x2 =
+    Bytes("\xff\x00\x00\xff\x00\xff\x00\xff\x00\x00\xff\xff\xff\xff\xff\xff", 16);
 
 // TGA header: type 2 (raw true colour) or 10 (RLE), 32 bits per pixel, top-down rows.
 Bytes tga_header(int type, uint16_t width, uint16_t height) {
@@ -195,8 +198,8 @@ Bytes polygon_obj(int n) {
   return obj + "\n";
 }
 
-Case error_case(std::string name, std::map<std::string, Bytes> files,
-                std::vector<std::string> args, std::string message, int code = kExitRuntime) {
+Case error_case(std::string name, std::map<std::string, Bytes> files, std::vector<std::string> args,
+                std::string message, int code = kExitRuntime) {
   return {std::move(name), std::move(files), std::move(args), code, std::move(message)};
 }
 
@@ -237,8 +240,8 @@ std::vector<Case> hostile_cases() {
   c.push_back(error_case("TGA as the model", {{"m.obj", tga}}, base_args("m.obj"), "m.obj"));
 
   const Bytes verts = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
-  c.push_back(error_case("face index 0", {{"m.obj", verts + "f 0 1 2\n"}}, base_args("m.obj"),
-                         "m.obj:4"));
+  c.push_back(
+      error_case("face index 0", {{"m.obj", verts + "f 0 1 2\n"}}, base_args("m.obj"), "m.obj:4"));
   c.push_back(error_case("face index past the end", {{"m.obj", verts + "f 1 2 4\n"}},
                          base_args("m.obj"), "m.obj:4"));
   c.push_back(error_case("negative face index past the start", {{"m.obj", verts + "f -4 -1 -2\n"}},
@@ -247,20 +250,23 @@ std::vector<Case> hostile_cases() {
                          base_args("m.obj"), "m.obj:4"));
   c.push_back(error_case("NUL byte", {{"m.obj", verts + Bytes("f 1 2 3\0\n", 9)}},
                          base_args("m.obj"), "m.obj"));
-  c.push_back(error_case("1 MiB line", {{"m.obj", verts + "#" + Bytes(1 << 20, 'x') + "\nf 1 2 3\n"}},
+  c.push_back(error_case("1 MiB line",
+                         {{"m.obj", verts + "#" + Bytes(1 << 20, 'x') + "\nf 1 2 3\n"}},
                          base_args("m.obj"), "m.obj:4"));
   for (const char* number : {"nan", "inf", "-inf", "1e400"}) {
-    c.push_back(error_case(std::string("vertex coordinate ") + number,
-                           {{"m.obj", std::string("v 0 0 ") + number + "\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"}},
-                           base_args("m.obj"), "m.obj:1"));
+    c.push_back(
+        error_case(std::string("vertex coordinate ") + number,
+                   {{"m.obj", std::string("v 0 0 ") + number + "\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"}},
+                   base_args("m.obj"), "m.obj:1"));
   }
-  c.push_back(ok_case("CRLF line ends", {{"m.obj", "v -1 -1 0\r\nv 1 -1 0\r\nv 0 1 0\r\nf 1 2 3\r\n"}},
+  c.push_back(ok_case("CRLF line ends",
+                      {{"m.obj", "v -1 -1 0\r\nv 1 -1 0\r\nv 0 1 0\r\nf 1 2 3\r\n"}},
                       base_args("m.obj")));
   c.push_back(error_case("lone CR line ends (one line, trailing garbage after a vertex)",
                          {{"m.obj", "v -1 -1 0\rv 1 -1 0\rv 0 1 0\rf 1 2 3\r"}}, base_args("m.obj"),
                          "m.obj"));
-  Case big_face = ok_case("face of 100,000 corners", {{"m.obj", polygon_obj(100000)}},
-                          base_args("m.obj"));
+  Case big_face =
+      ok_case("face of 100,000 corners", {{"m.obj", polygon_obj(100000)}}, base_args("m.obj"));
   big_face.max_seconds = 20.0;
   c.push_back(big_face);
 
@@ -297,13 +303,13 @@ std::vector<Case> hostile_cases() {
   c.push_back(error_case("unwritable output folder", {{"tri.obj", kTriangleObj}}, unwritable,
                          "/proc/softrast_out.png"));
   std::vector<std::string> huge = {"tri.obj", "-q", "--size", "16385x16385", "-o", "out.png"};
-  c.push_back(error_case("--size 16385x16385", {{"tri.obj", kTriangleObj}}, huge, "--size",
-                         kExitUsage));
+  c.push_back(
+      error_case("--size 16385x16385", {{"tri.obj", kTriangleObj}}, huge, "--size", kExitUsage));
   // The largest size is accepted, but the output folder is checked before 2 GiB are allocated.
-  std::vector<std::string> largest = {"tri.obj", "-q", "--size", "16384x16384", "-o",
-                                      "folder.png"};
+  std::vector<std::string> largest = {"tri.obj", "-q", "--size", "16384x16384", "-o", "folder.png"};
   c.push_back(error_case("--size 16384x16384 with a bad output",
-                         {{"tri.obj", kTriangleObj}, {"folder.png/x", "x"}}, largest, "folder.png"));
+                         {{"tri.obj", kTriangleObj}, {"folder.png/x", "x"}}, largest,
+                         "folder.png"));
   return c;
 }
 

@@ -88,9 +88,23 @@ Bytes jpeg(int w, int h, int components, bool progressive, int restart, int h_sa
 // for top-down rows.
 Bytes tga(int type, int w, int h, int bpp, bool top_down, const Bytes& body, int alpha_bits = 0,
           int map_length = 0, int map_bpp = 0) {
-  Bytes b = {0, uint8_t(map_length ? 1 : 0), uint8_t(type), 0, 0, uint8_t(map_length & 255),
-             uint8_t(map_length >> 8), uint8_t(map_bpp), 0, 0, 0, 0, uint8_t(w & 255),
-             uint8_t(w >> 8), uint8_t(h & 255), uint8_t(h >> 8), uint8_t(bpp),
+  Bytes b = {0,
+             uint8_t(map_length ? 1 : 0),
+             uint8_t(type),
+             0,
+             0,
+             uint8_t(map_length & 255),
+             uint8_t(map_length >> 8),
+             uint8_t(map_bpp),
+             0,
+             0,
+             0,
+             0,
+             uint8_t(w & 255),
+             uint8_t(w >> 8),
+             uint8_t(h & 255),
+             uint8_t(h >> 8),
+             uint8_t(bpp),
              uint8_t(alpha_bits | (top_down ? 0x20 : 0))};
   b.insert(b.end(), body.begin(), body.end());
   return b;
@@ -112,8 +126,8 @@ void image_seeds() {
   trns.n_type3_entries = 2;
   trns.type3_alpha[0] = 0;
   trns.type3_alpha[1] = 128;
-  put("png", "palette2_5x3.png", png(5, 3, 2, 3, Bytes{0x1b, 0x40, 0xe4, 0x10, 0x93, 0x00}, 0,
-                                     &plte, &trns));
+  put("png", "palette2_5x3.png",
+      png(5, 3, 2, 3, Bytes{0x1b, 0x40, 0xe4, 0x10, 0x93, 0x00}, 0, &plte, &trns));
 
   put("tga", "rgb_bottom_up_3x2.tga", tga(2, 3, 2, 24, false, ramp(18)));
   put("tga", "rgba_top_down_2x2.tga", tga(2, 2, 2, 32, true, ramp(16), 8));
@@ -123,8 +137,7 @@ void image_seeds() {
   put("tga", "rle_rgb_3x2.tga",
       tga(10, 3, 2, 24, false, Bytes{0x82, 1, 2, 3, 0x01, 4, 5, 6, 7, 8, 9, 0x80, 10, 11, 12}));
   put("tga", "rle_grey_top_down_4x1.tga", tga(11, 4, 1, 8, true, Bytes{0x81, 50, 0x01, 7, 9}));
-  put("tga", "rle_rgba_2x2.tga",
-      tga(10, 2, 2, 32, false, Bytes{0x83, 1, 2, 3, 4}, 8));
+  put("tga", "rle_rgba_2x2.tga", tga(10, 2, 2, 32, false, Bytes{0x83, 1, 2, 3, 4}, 8));
   Bytes mapped = {10, 20, 30, 40, 50, 60, 70, 80, 90, 0, 1, 2, 2, 1, 0};  // 3 BGR entries, 6 px
   put("tga", "colormapped_3x2.tga", tga(1, 3, 2, 8, false, mapped, 0, 3, 24));
 
@@ -151,12 +164,13 @@ void obj_seeds() {
   put("obj", "materials.obj",
       "mtllib model.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\n"
       "usemtl red\nf 1/1 2/2 3/3\nusemtl textured\nf 2/2 4/4 3/3\nusemtl missing\nf 1 2 4\n" +
-          mtl_sep +
-          "newmtl red\nKd 1 0 0\nNs 10\n\nnewmtl textured\nKd 1 1 1\nmap_Kd tex.png\n" + tex_sep);
+          mtl_sep + "newmtl red\nKd 1 0 0\nNs 10\n\nnewmtl textured\nKd 1 1 1\nmap_Kd tex.png\n" +
+          tex_sep);
   Bytes texture = tga(2, 2, 2, 24, false, ramp(12));
-  std::string with_texture = "mtllib model.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
-                             "usemtl t\nf 1/1 2/2 3/3\n" + mtl_sep +
-                             "newmtl t\nKd 0.5 0.5 0.5\nmap_Kd -o 0 0 tex.png\n" + tex_sep;
+  std::string with_texture =
+      "mtllib model.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+      "usemtl t\nf 1/1 2/2 3/3\n" +
+      mtl_sep + "newmtl t\nKd 0.5 0.5 0.5\nmap_Kd -o 0 0 tex.png\n" + tex_sep;
   with_texture.append(texture.begin(), texture.end());
   put("obj", "textured_tga.obj", with_texture);
   put("obj", "numbers.obj",
@@ -205,10 +219,13 @@ void geometry_seeds() {
   put_floats(a, {-0.5f, -0.5f, 0, 1, 0, 0, 0.5f, -0.5f, 0, 1, 1, 0, 0, 0.5f, 0, 1, 0, 1});
   put("geometry", "raw_one_triangle", a);
   Bytes b = {0x0b, 0x25};  // raw, scanline, wide, reference counting, sub-scissor
-  put_floats(b, {-2, -2, -3, 1, 0, 0, 3, -1, 0.5f, -1, 1, 0, 0, 4, 2, 0.5f, 0, 1,     // w < 0
-                 nan, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 1, 1, 0, 1, 0, 0,               // NaN
-                 1e38f, -1e38f, 0, 1e-38f, 0, 0, -1e30f, 1e30f, 0, 1, 0, 0, 0, 0, 0, 1e-45f, 0, 0,
-                 inf, 1, 0, 1, 0, 0, 0, -inf, 0, 1, 0, 0, 1, 1, 1, 1, inf, nan});
+  put_floats(b, {-2,    -2,     -3, 1,      0, 0, 3,      -1,    0.5f, -1, 1,   0,
+                 0,     4,      2,  0.5f,   0, 1,  // w < 0
+                 nan,   0,      0,  1,      0, 0, 0,      0,     0,    1,  0,   0,
+                 1,     1,      0,  1,      0, 0,  // NaN
+                 1e38f, -1e38f, 0,  1e-38f, 0, 0, -1e30f, 1e30f, 0,    1,  0,   0,
+                 0,     0,      0,  1e-45f, 0, 0, inf,    1,     0,    1,  0,   0,
+                 0,     -inf,   0,  1,      0, 0, 1,      1,     1,    1,  inf, nan});
   put("geometry", "raw_hostile", b);
   Bytes c = {0x04 | 0x10, 0x00};  // grid, back-face culled two-path draw
   // Two triangles sharing an edge through pixel centres, a third crossing the near plane.
