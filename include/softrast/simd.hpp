@@ -90,7 +90,11 @@ struct Float {
   SOFTRAST_SIMD_INLINE Float(float s) {
     V t = {};
     t[0] = s;
+#if defined(__clang__)  // no __builtin_shuffle; clang broadcasts a scalar added to a vector
+    for (int k = 0; k < kParts; ++k) p[k] = V{} + s;
+#else
     for (int k = 0; k < kParts; ++k) p[k] = __builtin_shuffle(t, typename Native<N>::I{});
+#endif
   }
   // (Typed unaligned vector accesses: GCC 12 splits a memcpy of the parts into 16-byte moves.)
   SOFTRAST_SIMD_INLINE static Float load(const float* lanes) {
@@ -158,7 +162,11 @@ struct Int {
   SOFTRAST_SIMD_INLINE Int(int32_t s) {  // broadcast, as Float's
     V t = {};
     t[0] = s;
+#if defined(__clang__)
+    for (int k = 0; k < kParts; ++k) p[k] = V{} + s;
+#else
     for (int k = 0; k < kParts; ++k) p[k] = __builtin_shuffle(t, V{});
+#endif
   }
   SOFTRAST_SIMD_INLINE static Int load(const int32_t* lanes) {
     Int r;

@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# Regenerates the seed corpora in fuzz/corpus/ (committed; run this only to change them).
+# Files that fuzzing found interesting are added beside the seeds by scripts/fuzz.sh --merge.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+g++ -std=c++20 -O1 -o "$out/make_seeds" fuzz/tools/make_seeds.cpp $(pkg-config --cflags --libs spng) -ljpeg
+"$out/make_seeds" fuzz/corpus
+find fuzz/corpus -type f | sort | xargs ls -l | awk '{print $5, $9}'
