@@ -661,6 +661,29 @@ TEST_F(IoTest, ObjWithGarbageOrMissingTextureWarnsAndLoads) {
                                    "texture");
 }
 
+// Files a model names that are pipes (FIFOs) are not opened: opening one waits for a writer
+// forever. Each is a warning and the model loads with defaults, at once.
+TEST_F(IoTest, ObjNamingAPipeAsMtlOrMapWarnsInsteadOfWaiting) {
+  ASSERT_EQ(::mkfifo(path("lib.mtl").c_str(), 0600), 0);
+  ASSERT_EQ(::mkfifo(path("tex.png").c_str(), 0600), 0);
+  write("m.mtl", "newmtl m\nKd 0.5 0.5 0.5\nmap_Kd tex.png\n");
+  write("p.obj",
+        std::string("mtllib lib.mtl\nmtllib m.mtl\n") + kQuadPositions + "usemtl m\nf 1 2 3\n");
+  auto start = std::chrono::steady_clock::now();
+  Result<Mesh> mesh = load_obj(path("p.obj"));
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  ASSERT_EQ(mesh->warnings.size(), 2u);
+  EXPECT_EQ(mesh->warnings[0], path("p.obj") +
+                                   ":1: material library 'lib.mtl' is not a regular file (a pipe "
+                                   "or device); its materials get the default colour");
+  EXPECT_EQ(mesh->warnings[1], path("p.obj") + ": material 'm': map_Kd: " + path("tex.png") +
+                                   ": not a regular file (a pipe or device); drawn without this "
+                                   "texture");
+  ASSERT_EQ(mesh->materials.size(), 1u);
+  EXPECT_EQ(mesh->materials[0].diffuse_map, nullptr);
+}
+
 TEST_F(IoTest, ObjWithMissingMtlLoadsWithoutMaterials) {
   write("n.obj", std::string("mtllib nowhere.mtl\n") + kQuadPositions + "usemtl m\nf 1 2 3\n");
   Result<Mesh> mesh = load_obj(path("n.obj"));

@@ -81,6 +81,14 @@ Status ObjMaterials::load_library(const std::string& name, const std::string& ob
                         "' not found; its materials get the default colour");
     return {};
   }
+  if (fs::exists(path, ignored) && !fs::is_regular_file(path, ignored) &&
+      !fs::is_directory(path, ignored)) {
+    // A pipe or device that a model names (opening a FIFO would wait for a writer forever).
+    warnings_.push_back(obj_path + ":" + std::to_string(obj_line) + ": material library '" + name +
+                        "' is not a regular file (a pipe or device); its materials get the "
+                        "default colour");
+    return {};
+  }
   std::string text;
   Status read = read_lines(
       path.string(), {max_bytes_, "MTL files"}, [&](std::string_view line, size_t number) {
@@ -115,6 +123,11 @@ using TextureCache = std::map<std::string, std::shared_ptr<const Texture>>;
 Result<std::shared_ptr<const Texture>> texture_at(const fs::path& file, TextureCache& cache) {
   std::string key = file.lexically_normal().string();
   if (auto it = cache.find(key); it != cache.end()) return it->second;
+  std::error_code ec;
+  if (fs::exists(file, ec) && !fs::is_regular_file(file, ec) && !fs::is_directory(file, ec)) {
+    // A pipe or device that a material names: opening a FIFO would wait for a writer forever.
+    return Status::error(key + ": not a regular file (a pipe or device)");
+  }
   Result<Image> image = load_image(key);
   if (!image.ok()) return image.status();
   auto texture = std::make_shared<const Texture>(Texture::from_image(*image));
