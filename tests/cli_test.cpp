@@ -355,8 +355,8 @@ TEST_F(CliTest, HeadlightLightsASphereEquallyFromSixDirections) {
   write("sphere.obj", obj);
   std::vector<double> means;
   for (const char* view : {"front", "back", "left", "right", "top", "bottom"}) {
-    CliRun r = run(std::string("sphere.obj --size 96x96 --shader gouraud --view ") +
-                   view + " -o lit_" + view + ".png");
+    CliRun r = run(std::string("sphere.obj --size 96x96 --shader gouraud --view ") + view +
+                   " -o lit_" + view + ".png");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     Image image = load(std::string("lit_") + view + ".png", 96, 96);
     int clear = pixel(image, 0, 0)[0];

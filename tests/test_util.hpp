@@ -19,12 +19,12 @@
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
+#include "fill_rule_oracle.hpp"
 #include "raster/raster.hpp"
 #include "raster/setup.hpp"
 #include "softrast/framebuffer.hpp"
 #include "softrast/render_state.hpp"
 #include "softrast/shader.hpp"
-#include "fill_rule_oracle.hpp"
 
 namespace softrast::test {
 

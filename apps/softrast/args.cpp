@@ -10,7 +10,8 @@ namespace {
 
 void define_output_flags(CLI::App& app, RawArgs& a) {
   app.add_option("MODEL", a.models,
-                 "Model files (Wavefront OBJ with the MTL files it names, PLY or STL, told by their contents) or "
+                 "Model files (Wavefront OBJ with the MTL files it names, PLY or STL, told by "
+                 "their contents) or "
                  "folders of them; "
                  "several are drawn together as one scene, each with its own materials. Without "
                  "MODEL, the built-in demo scene")

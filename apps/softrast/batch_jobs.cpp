@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "args.hpp"
+#include "values.hpp"
 
 namespace softrast::cli {
 namespace {
@@ -62,25 +63,9 @@ std::vector<std::string> known_keys(const CLI::App& app) {
   return keys;
 }
 
-// Levenshtein distance, for "did you mean".
-size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      size_t next = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
-      diagonal = row[j];
-      row[j] = next;
-    }
-  }
-  return row[b.size()];
-}
-
 Status unknown_key(const std::string& key, const CLI::App& app) {
   std::string closest;
-  size_t best = 3;  // suggest only keys at most 2 edits away
+  size_t best = 3;  // suggest only keys at most 2 edits away (edit_distance: values.hpp)
   for (const std::string& known : known_keys(app)) {
     size_t d = edit_distance(key, known);
     if (d < best) best = d, closest = known;

@@ -107,8 +107,12 @@ struct Float {
     for (int k = 0; k < kParts; ++k)
       *reinterpret_cast<typename Native<N>::FU*>(lanes + k * N) = p[k];
   }
-  SOFTRAST_SIMD_INLINE float lane(int i) const { return p[i / N][i % N]; }
-  SOFTRAST_SIMD_INLINE void set_lane(int i, float v) { p[i / N][i % N] = v; }
+  SOFTRAST_SIMD_INLINE float lane(int i) const {
+    return p[i / N][i % N];
+  }
+  SOFTRAST_SIMD_INLINE void set_lane(int i, float v) {
+    p[i / N][i % N] = v;
+  }
 
 #define SOFTRAST_SIMD_FLOAT_OP(op)                                                \
   SOFTRAST_SIMD_INLINE friend Float operator op(const Float& a, const Float& b) { \
@@ -178,7 +182,9 @@ struct Int {
     for (int k = 0; k < kParts; ++k)
       *reinterpret_cast<typename Native<N>::IU*>(lanes + k * N) = p[k];
   }
-  SOFTRAST_SIMD_INLINE int32_t lane(int i) const { return p[i / N][i % N]; }
+  SOFTRAST_SIMD_INLINE int32_t lane(int i) const {
+    return p[i / N][i % N];
+  }
 
 #define SOFTRAST_SIMD_INT_OP(op)                                            \
   SOFTRAST_SIMD_INLINE friend Int operator op(const Int& a, const Int& b) { \

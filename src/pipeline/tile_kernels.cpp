@@ -34,7 +34,8 @@ namespace avx2 {
 #pragma GCC push_options
 #pragma GCC target("avx512f,avx512bw,avx512dq,avx512vl")
 #if defined(__clang__)  // clang ignores GCC target pragmas (the fuzz preset builds with it)
-#pragma clang attribute push(__attribute__((target("avx512f,avx512bw,avx512dq,avx512vl"))), apply_to = function)
+#pragma clang attribute push(__attribute__((target("avx512f,avx512bw,avx512dq,avx512vl"))), \
+                             apply_to = function)
 #endif
 // GCC 12's _mm512_undefined_ps initialises a variable with itself and -Wmaybe-uninitialized
 // reports it inside every AVX-512 min/max (GCC bug 105593, fixed in GCC 13).

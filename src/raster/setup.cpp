@@ -88,7 +88,6 @@ void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area
 
 }  // namespace
 
-
 bool setup_triangle_coverage(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
                              int64_t area, const PixelRect& scissor, TriangleCoverage& out,
                              const WindowVertex* ordered[3]) {
