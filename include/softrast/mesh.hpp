@@ -9,6 +9,7 @@
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include "softrast/status.hpp"
 #include "softrast/texture.hpp"
@@ -34,6 +35,13 @@ struct Mesh {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
   std::vector<glm::vec2> uvs;
+  // Optional per-vertex data: empty, or one per position.
+  // Tangents for tangent-space normal maps, MikkTSpace's convention: xyz the tangent (the
+  // direction of increasing u, orthogonal to the normal), w = +1 or -1 the handedness, so that
+  // the bitangent (increasing v) is w * cross(normal, tangent). compute_tangents fills them.
+  std::vector<glm::vec4> tangents;
+  std::vector<glm::vec4> colors;   // linear RGBA vertex colours (glTF COLOR_0, PLY)
+  std::vector<glm::vec2> uvs1;     // a second texture coordinate set (glTF TEXCOORD_1)
   std::vector<uint32_t> indices;   // three per triangle
   std::vector<SubMesh> submeshes;  // cover `indices`; empty means one run with material -1
   std::vector<Material> materials;
@@ -95,5 +103,12 @@ Result<Mesh> load_model(const std::string& path);
 // Fills `mesh.normals` with area-weighted smooth normals per position (used when the file has
 // none). Degenerate neighbourhoods get (0, 0, 1).
 void compute_smooth_normals(Mesh& mesh);
+
+// Fills `mesh.tangents` from the positions, normals and uvs (MikkTSpace's convention, see Mesh):
+// each triangle's tangent and bitangent from its uv gradient, summed at its corners weighted by
+// the corner angle, then made orthogonal to the vertex normal (Gram-Schmidt); w is the sign of
+// the summed bitangent against cross(normal, tangent). A vertex whose triangles have no usable
+// uv gradient gets a tangent orthogonal to its normal, w = +1. Needs normals and uvs.
+void compute_tangents(Mesh& mesh);
 
 }  // namespace softrast
