@@ -132,9 +132,9 @@ struct Buffers {
 Buffers read_back(const Framebuffer& fb) {
   Buffers b;
   for (int y = 0; y < fb.height(); ++y) {
-    b.color.insert(b.color.end(), fb.color_row(y), fb.color_row(y) + fb.width());
-    b.depth.insert(b.depth.end(), fb.depth_row(y), fb.depth_row(y) + fb.width());
+    for (int x = 0; x < fb.width(); ++x) b.color.push_back(fb.color_at(x, y));
   }
+  b.depth = fb.depth_values();
   return b;
 }
 

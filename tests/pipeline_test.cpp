@@ -127,7 +127,7 @@ float stored_depth(int y) {
 
 void fill_depth_rows(Framebuffer& fb) {
   for (int y = 0; y < fb.height(); ++y) {
-    for (int x = 0; x < fb.width(); ++x) fb.depth_row(y)[x] = stored_depth(y);
+    for (int x = 0; x < fb.width(); ++x) fb.set_depth(x, y, stored_depth(y));
   }
 }
 

@@ -39,9 +39,7 @@ Rendered render_demo_at(SimdLevel level, const RenderOptions& options) {
   Framebuffer fb(320, 240);
   render_mesh(fb, scene.mesh, scene.camera, options);
   Rendered r{fb.to_image(), {}};
-  for (int y = 0; y < fb.height(); ++y) {
-    r.depth.insert(r.depth.end(), fb.depth_row(y), fb.depth_row(y) + fb.width());
-  }
+  r.depth = fb.depth_values();
   return r;
 }
 

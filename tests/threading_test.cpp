@@ -64,7 +64,7 @@ std::vector<uint32_t> render_soup(const Soup& soup, RenderState state, int threa
   draw(fb, state, shader, soup.indices, uint32_t(soup.positions.size()));
   std::vector<uint32_t> out;
   for (int y = 0; y < fb.height(); ++y) {
-    out.insert(out.end(), fb.color_row(y), fb.color_row(y) + fb.width());
+    for (int x = 0; x < fb.width(); ++x) out.push_back(fb.color_at(x, y));
   }
   return out;
 }

@@ -3,6 +3,7 @@
 #include "run.hpp"
 
 #include <sys/resource.h>
+#include <time.h>
 
 #include <algorithm>
 #include <chrono>
@@ -34,26 +35,47 @@ std::string size_text(const Job& job) {
   return std::to_string(job.framebuffer.width()) + "x" + std::to_string(job.framebuffer.height());
 }
 
+// CPU time of the whole process (every thread), milliseconds.
+double process_cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
+struct FrameTime {
+  double wall_ms = 0.0;
+  double cpu_ms = 0.0;  // CPU time of all threads: the work, whatever else the machine runs
+};
+
 // One frame as SCENES.md defines it: clear colour (--background) and depth, draw everything.
-// Milliseconds.
-double render_frame(Job& job) {
+FrameTime render_frame(Job& job) {
   auto start = std::chrono::steady_clock::now();
+  double cpu_start = process_cpu_ms();
   job.framebuffer.clear(job.background, 1.0f, job.options.state.threads);
   render_mesh(job.framebuffer, job.scene.mesh, job.scene.camera, job.options);
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
+  FrameTime t;
+  t.cpu_ms = process_cpu_ms() - cpu_start;
+  t.wall_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return t;
 }
 
 struct FrameStats {
-  double median_ms, min_ms, max_ms;
+  double median_ms, min_ms, max_ms, cpu_median_ms;
 };
 
-// Precondition: at least one time.
-FrameStats stats_of(std::vector<double> ms) {
-  std::sort(ms.begin(), ms.end());
-  size_t n = ms.size();
-  double median = n % 2 == 1 ? ms[n / 2] : 0.5 * (ms[n / 2 - 1] + ms[n / 2]);
-  return {median, ms.front(), ms.back()};
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Precondition: at least one frame.
+FrameStats stats_of(const std::vector<FrameTime>& frames) {
+  std::vector<double> wall, cpu;
+  for (const FrameTime& f : frames) wall.push_back(f.wall_ms), cpu.push_back(f.cpu_ms);
+  return {median_of(wall), *std::min_element(wall.begin(), wall.end()),
+          *std::max_element(wall.begin(), wall.end()), median_of(cpu)};
 }
 
 // A JSON string literal: quotes, backslashes and control characters escaped.
@@ -94,6 +116,7 @@ std::string json_line(const Job& job, const FrameStats& s) {
          ",\"triangles\":" + std::to_string(job.scene.mesh.triangle_count()) +
          ",\"median_ms\":" + format("%.3f", s.median_ms) +
          ",\"min_ms\":" + format("%.3f", s.min_ms) + ",\"max_ms\":" + format("%.3f", s.max_ms) +
+         ",\"cpu_ms\":" + format("%.3f", s.cpu_median_ms) +
          ",\"mtris_per_s\":" + format("%.3f", triangles / seconds / 1e6) +
          ",\"mpix_per_s\":" + format("%.3f", pixels / seconds / 1e6) +
          ",\"simd\":" + json_string(simd_level_name(simd_level())) +
@@ -102,7 +125,7 @@ std::string json_line(const Job& job, const FrameStats& s) {
 
 Status benchmark(Job& job) {
   for (int i = 0; i < kWarmupFrames; ++i) render_frame(job);
-  std::vector<double> times;
+  std::vector<FrameTime> times;
   for (int i = 0; i < job.frames; ++i) times.push_back(render_frame(job));
   FrameStats s = stats_of(times);
   std::string line = json_line(job, s) + "\n";
@@ -148,7 +171,7 @@ Status run_job(Job& job) {
   if (job.frames > 0) {
     if (Status s = benchmark(job); !s.ok()) return s;
   } else {
-    double ms = render_frame(job);
+    double ms = render_frame(job).wall_ms;
     progress(job, "rendered " + size_text(job) + " in " + format("%.1f", ms) + " ms");
   }
   if (!job.output) return {};
@@ -156,7 +179,7 @@ Status run_job(Job& job) {
 }
 
 double render_job_frame(Job& job) {
-  return render_frame(job);
+  return render_frame(job).wall_ms;
 }
 
 Status write_job_image(const Job& job) {

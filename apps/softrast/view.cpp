@@ -260,9 +260,13 @@ class Viewer {
     auto start = std::chrono::steady_clock::now();
     render_ms_ = render();
     Framebuffer& fb = *framebuffer_;
-    if (SDL_UpdateTexture(texture_, nullptr, fb.color_row(0), fb.width() * 4) != 0) {
+    void* pixels = nullptr;
+    int pitch = 0;
+    if (SDL_LockTexture(texture_, nullptr, &pixels, &pitch) != 0) {
       return sdl_error("cannot update the texture");
     }
+    fb.copy_rgba8(static_cast<uint8_t*>(pixels), size_t(pitch));
+    SDL_UnlockTexture(texture_);
     SDL_RenderClear(renderer_);
     SDL_RenderCopy(renderer_, texture_, nullptr, nullptr);
     SDL_RenderPresent(renderer_);

@@ -3,7 +3,10 @@
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <new>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -16,42 +19,117 @@
 
 namespace softrast {
 
+// Storage is tiled, as the rasterizer walks it: the image is cut into 64x64-pixel tiles (the
+// binning tiles), each tile into 16x16 blocks of 4x4 pixels, and a block's 16 pixels are stored
+// together (pixel (x, y) of the block is element 4 * y + x), so a block's colour is one 64-byte
+// line and its depth another, and a tile's 32 KiB are contiguous. The storage is padded to whole
+// tiles; padding pixels are never drawn. Read pixels with color_at / depth_at or copy the image
+// out with to_image / depth_values.
+//
+// Clears are lazy: clear() records the values and marks every tile; a tile is filled when it is
+// first written (a draw fills it just before it draws into it, while the tile is in cache) or
+// read, so a frame's clear costs no pass over memory of its own.
 class Framebuffer {
  public:
+  static constexpr int kTileSize = 64;  // pixels per tile side
+  static constexpr int kBlockSize = 4;  // pixels per block side
+
   // Precondition: 1 <= width, height <= kMaxImageSize (see create() for checked construction).
+  // Starts cleared to the defaults of clear().
   Framebuffer(int width, int height);
   // Checked construction: an error for sizes outside [1, kMaxImageSize].
   static Result<Framebuffer> create(int width, int height);
+  Framebuffer(const Framebuffer& other);
+  Framebuffer& operator=(const Framebuffer& other);
+  Framebuffer(Framebuffer&&) noexcept = default;
+  Framebuffer& operator=(Framebuffer&&) noexcept = default;
 
   int width() const { return width_; }
   int height() const { return height_; }
 
   // Clears colour (floats clamped to [0, 1]) and depth; the defaults are CONVENTIONS.md's.
+  // clear_color and clear_depth write every pixel at once.
   void clear_color(glm::vec4 color = {0.1f, 0.1f, 0.1f, 1.0f});
   void clear_depth(float depth = 1.0f);
-  void clear() {
-    clear_color();
-    clear_depth();
-  }
-  // Both at once, in bands of rows spread over `threads` threads (0: every core), each band's
-  // colour and depth together: the frame clear of a renderer that draws on several threads.
-  void clear(glm::vec4 color, float depth, int threads);
+  // Both, lazily (see above): the frame clear.
+  void clear(glm::vec4 color = {0.1f, 0.1f, 0.1f, 1.0f}, float depth = 1.0f);
+  // The same; `threads` is kept for source compatibility (the tiles are filled by the draws).
+  void clear(glm::vec4 color, float depth, int /*threads*/) { clear(color, depth); }
 
   // Packed RGBA8 pixel: byte 0 is red (little-endian uint32 = 0xAABBGGRR).
-  uint32_t* color_row(int y) { return &color_[size_t(y) * size_t(width_)]; }
-  const uint32_t* color_row(int y) const { return &color_[size_t(y) * size_t(width_)]; }
-  float* depth_row(int y) { return &depth_[size_t(y) * size_t(width_)]; }
-  const float* depth_row(int y) const { return &depth_[size_t(y) * size_t(width_)]; }
-  uint32_t color_at(int x, int y) const { return color_row(y)[x]; }
-  float depth_at(int x, int y) const { return depth_row(y)[x]; }
+  // Precondition for the pixel accessors: 0 <= x < width, 0 <= y < height.
+  uint32_t color_at(int x, int y) const {
+    return pending(tile_of(x, y)) ? pending_color_ : color_[index(x, y)];
+  }
+  float depth_at(int x, int y) const {
+    return pending(tile_of(x, y)) ? pending_depth_ : depth_[index(x, y)];
+  }
+  void set_color(int x, int y, uint32_t rgba) {
+    prepare(tile_of(x, y));
+    color_[index(x, y)] = rgba;
+  }
+  void set_depth(int x, int y, float depth) {
+    prepare(tile_of(x, y));
+    depth_[index(x, y)] = depth;
+  }
+
+  // For the pipeline: direct access to the storage of a tile that has no clear pending (after
+  // prepare_tile or write_pending_clears). Pixel (x, y), and the 16 pixels of the 4x4 block
+  // whose top-left pixel is (x, y) (multiples of 4), 64-byte aligned, pixel (x + i, y + j) at
+  // element 4 * j + i. Blocks cut by the image's right or bottom edge exist whole (the padding).
+  uint32_t* color_pixel(int x, int y) { return &color_[index(x, y)]; }
+  float* depth_pixel(int x, int y) { return &depth_[index(x, y)]; }
+  uint32_t* color_block(int x, int y) { return &color_[index(x, y)]; }
+  float* depth_block(int x, int y) { return &depth_[index(x, y)]; }
+  // Fills tile (tx, ty) (tile units) with the pending clear, if it has one. Distinct tiles may be
+  // prepared on different threads at once.
+  void prepare_tile(int tx, int ty) { prepare(size_t(ty) * size_t(tiles_x_) + size_t(tx)); }
+  // Fills every tile that still has a clear pending, on `threads` threads (0: every core).
+  void write_pending_clears(int threads);
+
+  // Where pixel (x, y) is stored (elements from the first).
+  size_t index(int x, int y) const {
+    size_t tile = size_t(y >> 6) * size_t(tiles_x_) + size_t(x >> 6);
+    size_t block = size_t(((y >> 2) & 15) * 16 + ((x >> 2) & 15));
+    return tile * 4096 + block * 16 + size_t((y & 3) * 4 + (x & 3));
+  }
 
   Image to_image() const;
+  // The colour as RGBA8 rows, top row first, `pitch` bytes apart (for a window's texture).
+  void copy_rgba8(uint8_t* out, size_t pitch) const;
+  // The depth of every pixel, row by row, top row first.
+  std::vector<float> depth_values() const;
 
  private:
+  template <class T>
+  struct AlignedDelete {
+    void operator()(T* p) const { ::operator delete[](p, std::align_val_t(64)); }
+  };
+  template <class T>
+  using Buffer = std::unique_ptr<T[], AlignedDelete<T>>;
+  template <class T>
+  static Buffer<T> allocate(size_t n) {
+    return Buffer<T>(static_cast<T*>(::operator new[](n * sizeof(T), std::align_val_t(64))));
+  }
+
+  size_t tile_of(int x, int y) const { return size_t(y >> 6) * size_t(tiles_x_) + size_t(x >> 6); }
+  bool pending(size_t tile) const { return any_pending_ && pending_[tile] != 0; }
+  void prepare(size_t tile) {
+    if (pending(tile)) fill_tile(tile);
+  }
+  void fill_tile(size_t tile);
+
   int width_;
   int height_;
-  std::vector<uint32_t> color_;
-  std::vector<float> depth_;
+  int tiles_x_;
+  size_t size_;  // pixels stored, with the padding
+  Buffer<uint32_t> color_;
+  Buffer<float> depth_;
+  // The lazy clear: the values, and per tile whether it still has to be filled with them.
+  std::vector<uint8_t> pending_;
+  bool any_pending_ = false;
+  uint32_t pending_color_ = 0;
+  float pending_depth_ = 1.0f;
 };
 
 // Float colour to RGBA8 by the conventions: clamp to [0, 1], then x * 255 + 0.5 truncated.

@@ -506,60 +506,6 @@ SOFTRAST_SIMD_INLINE Int<N> lane_row() {
   return Int<N>::load(kLaneRow);
 }
 
-// The 4x4 block of a row-major array of 32-bit values (float or uint32_t) whose top-left element
-// is `at`, `stride` elements per row, into the 16 lanes of V (Float<N> or Int<N>) and back. Rows
-// are loaded as 4-lane vectors and joined in registers (a wide load of four narrow stores would
-// stall store forwarding).
-template <class V, class T>
-SOFTRAST_SIMD_INLINE V load_block(const T* at, size_t stride) {
-  static_assert(sizeof(T) == 4);
-  using Row = typename Native<4>::F;
-  using Part = std::remove_reference_t<decltype(V{}.p[0])>;
-  Row r[4];
-  for (int k = 0; k < 4; ++k) {
-    r[k] = Row(*reinterpret_cast<const typename Native<4>::FU*>(at + stride * size_t(k)));
-  }
-  V out;
-  constexpr int kParts = V::kParts;
-  if constexpr (kParts == 4) {
-    for (int k = 0; k < 4; ++k) out.p[k] = Part(r[k]);
-  } else if constexpr (kParts == 2) {
-    out.p[0] = Part(__builtin_shufflevector(r[0], r[1], 0, 1, 2, 3, 4, 5, 6, 7));
-    out.p[1] = Part(__builtin_shufflevector(r[2], r[3], 0, 1, 2, 3, 4, 5, 6, 7));
-  } else {
-    auto a = __builtin_shufflevector(r[0], r[1], 0, 1, 2, 3, 4, 5, 6, 7);
-    auto b = __builtin_shufflevector(r[2], r[3], 0, 1, 2, 3, 4, 5, 6, 7);
-    out.p[0] =
-        Part(__builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
-  }
-  return out;
-}
-template <class V, class T>
-SOFTRAST_SIMD_INLINE void store_block(T* at, size_t stride, const V& v) {
-  static_assert(sizeof(T) == 4);
-  using Row = typename Native<4>::F;
-  Row r[4];
-  constexpr int kParts = V::kParts;
-  if constexpr (kParts == 4) {
-    for (int k = 0; k < 4; ++k) r[k] = Row(v.p[k]);
-  } else if constexpr (kParts == 2) {
-    auto a = typename Native<8>::F(v.p[0]), b = typename Native<8>::F(v.p[1]);
-    r[0] = __builtin_shufflevector(a, a, 0, 1, 2, 3);
-    r[1] = __builtin_shufflevector(a, a, 4, 5, 6, 7);
-    r[2] = __builtin_shufflevector(b, b, 0, 1, 2, 3);
-    r[3] = __builtin_shufflevector(b, b, 4, 5, 6, 7);
-  } else {
-    auto a = typename Native<16>::F(v.p[0]);
-    r[0] = __builtin_shufflevector(a, a, 0, 1, 2, 3);
-    r[1] = __builtin_shufflevector(a, a, 4, 5, 6, 7);
-    r[2] = __builtin_shufflevector(a, a, 8, 9, 10, 11);
-    r[3] = __builtin_shufflevector(a, a, 12, 13, 14, 15);
-  }
-  for (int k = 0; k < 4; ++k) {
-    *reinterpret_cast<typename Native<4>::FU*>(at + stride * size_t(k)) = r[k];
-  }
-}
-
 // ---- Small vectors of wide values, with glm's names. ----
 
 template <int N>

@@ -1,9 +1,17 @@
 // core/thread_pool.cpp: workers sleep on a condition variable between jobs; a job is a counter
 // of indices that the workers and the caller take from until it runs out.
+//
+// A draw runs several short jobs back to back (vertices, then per batch the setup and the
+// tiles), and a thread woken from a condition variable starts tens of microseconds late (more on
+// a virtual machine), so workers and the waiting caller first spin for a short while (about 50
+// microseconds) watching for the next job or the end of this one, and only then sleep.
 #include "softrast/detail/parallel.hpp"
+
+#include <emmintrin.h>
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
@@ -13,6 +21,20 @@ namespace softrast::detail {
 namespace {
 
 thread_local bool t_inside_pool_job = false;
+
+// Spins until done() or about kSpinTime has passed; true if done() came true.
+constexpr auto kSpinTime = std::chrono::microseconds(50);
+template <class Done>
+bool spin_until(Done&& done) {
+  auto start = std::chrono::steady_clock::now();
+  for (;;) {
+    for (int i = 0; i < 64; ++i) {
+      if (done()) return true;
+      _mm_pause();
+    }
+    if (std::chrono::steady_clock::now() - start > kSpinTime) return done();
+  }
+}
 
 class ThreadPool {
  public:
@@ -45,13 +67,14 @@ class ThreadPool {
       count_ = count;
       next_.store(0);
       helpers_ = helpers;
-      busy_ = helpers;
-      ++generation_;
+      busy_.store(helpers);
+      generation_.fetch_add(1, std::memory_order_release);
     }
     if (helpers > 0) wake_.notify_all();
     work();
+    if (spin_until([this] { return busy_.load(std::memory_order_acquire) == 0; })) return;
     std::unique_lock lock(mutex_);
-    done_.wait(lock, [this] { return busy_ == 0; });
+    done_.wait(lock, [this] { return busy_.load() == 0; });
   }
 
  private:
@@ -65,15 +88,17 @@ class ThreadPool {
   void worker(int id) {
     uint64_t seen = 0;
     for (;;) {
+      spin_until([&] { return generation_.load(std::memory_order_acquire) != seen; });
       {
         std::unique_lock lock(mutex_);
-        wake_.wait(lock, [&] { return stopping_ || (generation_ != seen && id < helpers_); });
+        wake_.wait(lock,
+                   [&] { return stopping_ || (generation_.load() != seen && id < helpers_); });
         if (stopping_) return;
-        seen = generation_;
+        seen = generation_.load();
       }
       work();
       std::lock_guard lock(mutex_);
-      if (--busy_ == 0) done_.notify_one();
+      if (busy_.fetch_sub(1) == 1) done_.notify_one();
     }
   }
 
@@ -82,9 +107,9 @@ class ThreadPool {
   std::mutex mutex_;
   std::condition_variable wake_, done_;
   bool stopping_ = false;
-  uint64_t generation_ = 0;
+  std::atomic<uint64_t> generation_{0};
   int helpers_ = 0;
-  int busy_ = 0;
+  std::atomic<int> busy_{0};
   void (*fn_)(void*, size_t) = nullptr;
   void* context_ = nullptr;
   size_t count_ = 0;

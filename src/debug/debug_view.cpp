@@ -88,9 +88,9 @@ void draw_overdraw(Framebuffer& fb, const Mesh& mesh, const Camera& camera,
   CountingShader shader{mesh.positions.data(), mvp_of(fb, camera)};
   draw(counts, state, shader, triangle_indices(mesh), uint32_t(mesh.positions.size()));
   for (int y = 0; y < fb.height(); ++y) {
-    const uint32_t* in = counts.color_row(y);
-    uint32_t* out = fb.color_row(y);
-    for (int x = 0; x < fb.width(); ++x) out[x] = overdraw_color(int(in[x] & 0xffu));
+    for (int x = 0; x < fb.width(); ++x) {
+      fb.set_color(x, y, overdraw_color(int(counts.color_at(x, y) & 0xffu)));
+    }
   }
 }
 
@@ -109,12 +109,8 @@ void draw_triangles(Framebuffer& fb, const Mesh& mesh, const Camera& camera,
 
 void draw_tile_grid(Framebuffer& fb) {
   for (int y = 0; y < fb.height(); ++y) {
-    uint32_t* row = fb.color_row(y);
-    if (y % kDebugTileSize == 0) {
-      std::fill(row, row + fb.width(), kTileGridColor);
-      continue;
-    }
-    for (int x = 0; x < fb.width(); x += kDebugTileSize) row[x] = kTileGridColor;
+    int step = y % kDebugTileSize == 0 ? 1 : kDebugTileSize;
+    for (int x = 0; x < fb.width(); x += step) fb.set_color(x, y, kTileGridColor);
   }
 }
 
@@ -123,7 +119,6 @@ void draw_cost(Framebuffer& fb, const TileTimes& times) {
   double slowest = 0.0;
   for (double s : times.seconds) slowest = std::max(slowest, s);
   for (int y = 0; y < fb.height(); ++y) {
-    uint32_t* row = fb.color_row(y);
     int ty = y / kDebugTileSize;
     for (int x = 0; x < fb.width(); ++x) {
       int tx = x / kDebugTileSize;
@@ -132,9 +127,9 @@ void draw_cost(Framebuffer& fb, const TileTimes& times) {
         spent = times.seconds[size_t(ty) * size_t(times.tiles_x) + size_t(tx)];
       }
       glm::vec3 heat = heat_color(slowest > 0.0 ? float(spent / slowest) : 0.0f);
-      glm::vec4 c = unpack_rgba8(row[x]);
+      glm::vec4 c = unpack_rgba8(fb.color_at(x, y));
       float grey = 0.299f * c.r + 0.587f * c.g + 0.114f * c.b;
-      row[x] = pack_rgba8(glm::vec4(glm::vec3(0.35f * grey) + 0.65f * heat, 1.0f));
+      fb.set_color(x, y, pack_rgba8(glm::vec4(glm::vec3(0.35f * grey) + 0.65f * heat, 1.0f)));
     }
   }
   draw_tile_grid(fb);

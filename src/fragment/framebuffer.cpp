@@ -9,11 +9,33 @@
 namespace softrast {
 
 Framebuffer::Framebuffer(int width, int height)
-    : width_(width),
-      height_(height),
-      color_(size_t(width) * size_t(height)),
-      depth_(size_t(width) * size_t(height)) {
+    : width_(width), height_(height), tiles_x_((width + kTileSize - 1) / kTileSize) {
+  int tiles_y = (height + kTileSize - 1) / kTileSize;
+  size_ = size_t(tiles_x_) * size_t(tiles_y) * kTileSize * kTileSize;
+  color_ = allocate<uint32_t>(size_);
+  depth_ = allocate<float>(size_);
+  pending_.assign(size_t(tiles_x_) * size_t(tiles_y), 0);
   clear();
+}
+
+Framebuffer::Framebuffer(const Framebuffer& other)
+    : width_(other.width_),
+      height_(other.height_),
+      tiles_x_(other.tiles_x_),
+      size_(other.size_),
+      pending_(other.pending_),
+      any_pending_(other.any_pending_),
+      pending_color_(other.pending_color_),
+      pending_depth_(other.pending_depth_) {
+  color_ = allocate<uint32_t>(size_);
+  depth_ = allocate<float>(size_);
+  std::memcpy(color_.get(), other.color_.get(), size_ * sizeof(uint32_t));
+  std::memcpy(depth_.get(), other.depth_.get(), size_ * sizeof(float));
+}
+
+Framebuffer& Framebuffer::operator=(const Framebuffer& other) {
+  if (this != &other) *this = Framebuffer(other);
+  return *this;
 }
 
 Result<Framebuffer> Framebuffer::create(int width, int height) {
@@ -26,37 +48,76 @@ Result<Framebuffer> Framebuffer::create(int width, int height) {
 }
 
 void Framebuffer::clear_color(glm::vec4 color) {
-  std::fill(color_.begin(), color_.end(), pack_rgba8(color));
+  write_pending_clears(1);  // the depth of pending tiles is still to be written
+  std::fill(color_.get(), color_.get() + size_, pack_rgba8(color));
 }
 
 void Framebuffer::clear_depth(float depth) {
-  std::fill(depth_.begin(), depth_.end(), depth);
+  write_pending_clears(1);
+  std::fill(depth_.get(), depth_.get() + size_, depth);
 }
 
-void Framebuffer::clear(glm::vec4 color, float depth, int threads) {
-  const uint32_t packed = pack_rgba8(color);
-  // Bands of about 256 KiB of both buffers: enough work per index, and a band's colour and
-  // depth are written by the same thread.
-  const size_t pixels = color_.size();
-  const size_t band = std::max<size_t>(size_t(32) << 10, size_t(width_));
-  const size_t bands = (pixels + band - 1) / band;
+void Framebuffer::clear(glm::vec4 color, float depth) {
+  pending_color_ = pack_rgba8(color);
+  pending_depth_ = depth;
+  std::fill(pending_.begin(), pending_.end(), uint8_t(1));
+  any_pending_ = true;
+}
+
+void Framebuffer::fill_tile(size_t tile) {
+  constexpr size_t kTilePixels = size_t(kTileSize) * kTileSize;
+  std::fill_n(color_.get() + tile * kTilePixels, kTilePixels, pending_color_);
+  std::fill_n(depth_.get() + tile * kTilePixels, kTilePixels, pending_depth_);
+  pending_[tile] = 0;
+}
+
+void Framebuffer::write_pending_clears(int threads) {
+  if (!any_pending_) return;
   int n = threads > 0 ? threads : detail::hardware_threads();
-  detail::parallel_for(bands, n, [&](size_t b) {
-    size_t begin = b * band, end = std::min(pixels, begin + band);
-    std::fill(color_.begin() + ptrdiff_t(begin), color_.begin() + ptrdiff_t(end), packed);
-    std::fill(depth_.begin() + ptrdiff_t(begin), depth_.begin() + ptrdiff_t(end), depth);
+  // Eight tiles (128 KiB of each buffer) per job: enough work per index.
+  constexpr size_t kTilesPerJob = 8;
+  size_t jobs = (pending_.size() + kTilesPerJob - 1) / kTilesPerJob;
+  detail::parallel_for(jobs, n, [&](size_t job) {
+    size_t end = std::min(pending_.size(), (job + 1) * kTilesPerJob);
+    for (size_t t = job * kTilesPerJob; t < end; ++t) {
+      if (pending_[t]) fill_tile(t);
+    }
   });
+  any_pending_ = false;
 }
 
 Image Framebuffer::to_image() const {
   Image image(width_, height_);
-  for (size_t i = 0; i < color_.size(); ++i) {
-    uint32_t p = color_[i];
-    uint8_t* out = &image.rgba[i * 4];
-    out[0] = uint8_t(p), out[1] = uint8_t(p >> 8), out[2] = uint8_t(p >> 16),
-    out[3] = uint8_t(p >> 24);
-  }
+  copy_rgba8(image.rgba.data(), size_t(width_) * 4);
   return image;
+}
+
+void Framebuffer::copy_rgba8(uint8_t* out, size_t pitch) const {
+  // Little-endian 0xAABBGGRR is the bytes R, G, B, A: a block row is 16 bytes as they are.
+  for (int y = 0; y < height_; ++y) {
+    uint8_t* row = out + size_t(y) * pitch;
+    int x = 0;
+    for (; x + kBlockSize <= width_; x += kBlockSize) {
+      if (pending(tile_of(x, y))) {
+        for (int i = 0; i < kBlockSize; ++i)
+          std::memcpy(row + size_t(x + i) * 4, &pending_color_, 4);
+      } else {
+        std::memcpy(row + size_t(x) * 4, &color_[index(x, y)], 16);
+      }
+    }
+    for (; x < width_; ++x) {
+      uint32_t c = color_at(x, y);
+      std::memcpy(row + size_t(x) * 4, &c, 4);
+    }
+  }
+}
+
+std::vector<float> Framebuffer::depth_values() const {
+  std::vector<float> out(size_t(width_) * size_t(height_));
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x) out[size_t(y) * size_t(width_) + size_t(x)] = depth_at(x, y);
+  }
+  return out;
 }
 
 }  // namespace softrast

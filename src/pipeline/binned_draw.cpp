@@ -32,9 +32,13 @@
 #include "pipeline/tile_visibility.hpp"
 #include "pipeline/triangle_record.hpp"
 #include "softrast/detail/parallel.hpp"
+#include "softrast/framebuffer.hpp"
 
 namespace softrast::detail {
 namespace {
+
+static_assert(Framebuffer::kTileSize == kTileSize && Framebuffer::kBlockSize == kBlockSize,
+              "the framebuffer stores the binning tiles contiguously");
 
 // Triangles per batch: bounds the records held at once (about 200 bytes each for 3 varyings).
 constexpr size_t kBatchTriangles = 32768;
@@ -227,6 +231,10 @@ class BinnedDraw {
       for (size_t tile = next.fetch_add(1); tile < tiles; tile = next.fetch_add(1)) {
         auto start = state_.tile_times ? std::chrono::steady_clock::now()
                                        : std::chrono::steady_clock::time_point{};
+        if (!has_records(tile)) continue;
+        // A clear still pending on the tile is written now, into the cache the tile is drawn in.
+        target_.framebuffer->prepare_tile(int(tile % size_t(tiles_x_)),
+                                          int(tile / size_t(tiles_x_)));
         if (deferred_ && worth_deferring(tile)) {
           resolve_and_shade_tile(tile, *cache_.scratch[worker]);
         } else {
@@ -238,6 +246,13 @@ class BinnedDraw {
         }
       }
     });
+  }
+
+  bool has_records(size_t tile) const {
+    for (const Chunk& chunk : chunks()) {
+      if (!chunk.bins[tile].empty()) return true;
+    }
+    return false;
   }
 
   // Deferred shading pays for its visibility pass only where triangles overlap: a tile whose
@@ -283,9 +298,6 @@ class BinnedDraw {
   // Phase 2, deferred shading (tile_visibility.hpp): visibility of all the tile's triangles
   // first, in submission order, then one shading call per block and winning triangle.
   void resolve_and_shade_tile(size_t tile, DeferredScratch& scratch) {
-    bool any = false;
-    for (const Chunk& chunk : chunks()) any |= !chunk.bins[tile].empty();
-    if (!any) return;
     TileVisibility& visibility = scratch.visibility;
     TileJob job;
     job.region = tile_region(tile);

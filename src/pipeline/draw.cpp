@@ -137,6 +137,7 @@ void draw_clip_space(Framebuffer& framebuffer, const RenderState& state,
     draw_triangles_binned(geometry, state, target, program, indices, index_count, threads);
     return;
   }
+  framebuffer.write_pending_clears(threads);  // SerialDraw writes anywhere
   SerialDraw(geometry, state, target, program).draw(indices, index_count);
 }
 

@@ -173,33 +173,18 @@ enum class Mode { kImmediate, kLess, kLessEqual };
   return block_rect_mask(0, std::min(kBlockSize, r.x1 - x), 0, std::min(kBlockSize, r.y1 - y));
 }
 
-// Copies a block's depth in from the framebuffer before its first test. A whole block goes in as
-// wide stores of the width the resolve then loads: four 16-byte row stores read back by one
-// 64-byte load cannot be forwarded and stall until they retire (seen as the hottest instruction
-// of single-layer scenes).
+// Copies a block's depth in from the framebuffer before its first test: one 64-byte line.
 [[gnu::always_inline]] inline void load_depth(TileVisibility& v, int b, int x, int y) {
-#if SOFTRAST_LANES >= 8
-  if (x + kBlockSize <= v.region.x1 && y + kBlockSize <= v.region.y1) {
-    const Framebuffer& fb = *v.framebuffer;
-    __m128 r0 = _mm_loadu_ps(fb.depth_row(y) + x), r1 = _mm_loadu_ps(fb.depth_row(y + 1) + x);
-    __m128 r2 = _mm_loadu_ps(fb.depth_row(y + 2) + x), r3 = _mm_loadu_ps(fb.depth_row(y + 3) + x);
+  const float* from = v.framebuffer->depth_block(x, y);
 #if SOFTRAST_LANES == 16
-    __m512 all = _mm512_castps128_ps512(r0);
-    all = _mm512_insertf32x4(all, r1, 1);
-    all = _mm512_insertf32x4(all, r2, 2);
-    all = _mm512_insertf32x4(all, r3, 3);
-    _mm512_store_ps(v.depth[b], all);
+  _mm512_store_ps(v.depth[b], _mm512_load_ps(from));
+#elif SOFTRAST_LANES == 8
+  _mm256_store_ps(v.depth[b], _mm256_load_ps(from));
+  _mm256_store_ps(v.depth[b] + 8, _mm256_load_ps(from + 8));
 #else
-    _mm256_store_ps(v.depth[b], _mm256_insertf128_ps(_mm256_castps128_ps256(r0), r1, 1));
-    _mm256_store_ps(v.depth[b] + 8, _mm256_insertf128_ps(_mm256_castps128_ps256(r2), r3, 1));
+  for (int k = 0; k < 16; k += 4) _mm_store_ps(v.depth[b] + k, _mm_load_ps(from + k));
 #endif
-    v.mark_loaded(b);
-    return;
-  }
-#else
-  (void)b;
-#endif
-  v.block(x, y);  // the image's border blocks, and SSE2 (16-byte loads match 16-byte stores)
+  v.mark_loaded(b);
 }
 
 // Where a record's covered blocks go: the fragment stage, or the tile's depth resolve.

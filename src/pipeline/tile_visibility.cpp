@@ -24,16 +24,7 @@ void TileVisibility::load_block(int b) {
   touched[b >> 6] |= uint64_t(1) << (b & 63);
   int x0 = region.x0 + (b % kBlocksPerRow) * kBlockSize;
   int y0 = region.y0 + (b / kBlocksPerRow) * kBlockSize;
-  int cols = std::min(kBlockSize, region.x1 - x0), rows = std::min(kBlockSize, region.y1 - y0);
-  if (cols == kBlockSize) {  // a constant size: four inlined 16-byte copies
-    for (int r = 0; r < rows; ++r) {
-      std::memcpy(&depth[b][4 * r], framebuffer->depth_row(y0 + r) + x0, sizeof(float) * 4);
-    }
-    return;
-  }
-  for (int r = 0; r < rows; ++r) {
-    std::memcpy(&depth[b][4 * r], framebuffer->depth_row(y0 + r) + x0, sizeof(float) * cols);
-  }
+  std::memcpy(depth[b], framebuffer->depth_block(x0, y0), sizeof(depth[b]));
 }
 
 void TileVisibility::store_depth() const {
@@ -42,15 +33,7 @@ void TileVisibility::store_depth() const {
       int b = word * 64 + __builtin_ctzll(bits);
       int x0 = region.x0 + (b % kBlocksPerRow) * kBlockSize;
       int y0 = region.y0 + (b / kBlocksPerRow) * kBlockSize;
-      int cols = std::min(kBlockSize, region.x1 - x0), rows = std::min(kBlockSize, region.y1 - y0);
-      for (int r = 0; r < rows; ++r) {
-        float* row = framebuffer->depth_row(y0 + r) + x0;
-        if (cols == kBlockSize) {
-          std::memcpy(row, &depth[b][4 * r], sizeof(float) * 4);
-        } else {
-          std::memcpy(row, &depth[b][4 * r], sizeof(float) * cols);
-        }
-      }
+      std::memcpy(framebuffer->depth_block(x0, y0), depth[b], sizeof(depth[b]));
     }
   }
 }

@@ -121,11 +121,11 @@ DepthRange visible_depth_range(int width, int height, const Mesh& mesh, const Ca
   }
   float lo = 1.0f, hi = 0.0f;
   for (int y = 0; y < height; ++y) {
-    const float* row = scratch.depth_row(y);
     for (int x = 0; x < width; ++x) {
-      if (row[x] >= 1.0f) continue;  // the clear value: nothing drawn here
-      lo = std::min(lo, row[x]);
-      hi = std::max(hi, row[x]);
+      float d = scratch.depth_at(x, y);
+      if (d >= 1.0f) continue;  // the clear value: nothing drawn here
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
     }
   }
   if (lo > hi) return {camera.near_plane, camera.far_plane};

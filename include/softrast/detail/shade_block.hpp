@@ -135,14 +135,14 @@ void shade_quad(const S& shader, const ShadeTarget& target, const Interpolants& 
     fi.ddy = ddy;
     glm::vec4 color;
     if (!shader.fragment(fi, color)) continue;  // discarded
-    float* depth = &fb.depth_row(py)[px];
+    float* depth = fb.depth_pixel(px, py);
     if (kLateDepth) {
       fi.depth = std::clamp(fi.depth, 0.0f, 1.0f);
       if (!(fi.depth >= 0.0f)) fi.depth = 0.0f;  // NaN
       if (depth_test && !depth_passes(depth_func, fi.depth, *depth)) continue;
     }
     if (depth_test && depth_write) *depth = fi.depth;
-    uint32_t* pixel = &fb.color_row(py)[px];
+    uint32_t* pixel = fb.color_pixel(px, py);
     *pixel = blend == BlendMode::kOpaque ? pack_rgba8(color) : blend_pixel(blend, color, *pixel);
   }
 }

@@ -154,29 +154,6 @@ SOFTRAST_SIMD_INLINE simd::Int<N> blend(BlendMode mode, const simd::Vec4<N>& col
   return pack_rgba8(out);
 }
 
-// Blocks cut by the right or bottom edge of the image: only the pixels inside are read (the rest
-// read as 0) and only live pixels written, lane by lane, so nothing outside the image (or in the
-// next row, which another tile may be writing) is touched.
-template <class V, class T>
-SOFTRAST_SIMD_INLINE V load_edge_block(const T* at, size_t stride, int cols, int rows) {
-  alignas(64) T lanes[simd::kLanes] = {};
-  for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) lanes[4 * r + c] = at[stride * size_t(r) + size_t(c)];
-  }
-  using Lane = std::conditional_t<std::is_same_v<T, float>, float, int32_t>;
-  return V::load(reinterpret_cast<const Lane*>(lanes));
-}
-template <class V, class T>
-SOFTRAST_SIMD_INLINE void store_edge_block(T* at, size_t stride, const V& v, uint32_t live) {
-  using Lane = std::conditional_t<std::is_same_v<T, float>, float, int32_t>;
-  alignas(64) Lane lanes[simd::kLanes];
-  v.store(lanes);
-  for (; live != 0; live &= live - 1) {
-    int i = __builtin_ctz(live);
-    std::memcpy(&at[stride * size_t(i >> 2) + size_t(i & 3)], &lanes[i], sizeof(T));
-  }
-}
-
 [[noreturn]] inline void undeclared_discard() {
   std::fprintf(stderr,
                "softrast: a shader discarded pixels without declaring kDiscards = true; the "
@@ -209,14 +186,13 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   F z = simd::clamp(eval_plane<N>(in.z, dx, dy), F(0.0f), F(1.0f));
   f.live = simd::lanes_of<N>(mask);
 
-  float* depth_at = &fb.depth_row(y)[x];
-  const int cols = std::min(4, fb.width() - x), rows = std::min(4, fb.height() - y);
-  const bool edge = cols < 4 || rows < 4;
-  const size_t stride = size_t(fb.width());
+  // The framebuffer stores a block's 16 pixels together (framebuffer.hpp): one aligned vector
+  // load or store each for depth and colour. Blocks cut by the image's edge exist whole, and
+  // only covered pixels (never padding) are live.
+  float* depth_at = fb.depth_block(x, y);
   F stored;
   if (depth_test) {
-    stored = edge ? load_edge_block<F>(depth_at, stride, cols, rows)
-                  : simd::load_block<F>(depth_at, stride);
+    stored = F::load(depth_at);
     if (!kLateDepth) {  // early depth test: the shader cannot change depth
       f.live = f.live & depth_passes<N>(depth_func, z, stored);
       if (!simd::any(f.live)) return;
@@ -246,24 +222,17 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   }
   const uint32_t live = simd::bits(f.live);
   if (live == 0) return;
-  uint32_t* color_at = &fb.color_row(y)[x];
-  if (edge) {
-    if (depth_test && depth_write) store_edge_block(depth_at, stride, z, live);
-    I old =
-        blend_mode == BlendMode::kOpaque ? I(0) : load_edge_block<I>(color_at, stride, cols, rows);
-    store_edge_block(color_at, stride, blend<N>(blend_mode, f.color, old), live);
-    return;
-  }
+  int32_t* color_at = reinterpret_cast<int32_t*>(fb.color_block(x, y));
   if (depth_test && depth_write) {
-    simd::store_block(depth_at, stride, live == 0xffffu ? z : simd::select(f.live, z, stored));
+    (live == 0xffffu ? z : simd::select(f.live, z, stored)).store(depth_at);
   }
   if (live == 0xffffu && blend_mode == BlendMode::kOpaque) {  // the common full block
-    simd::store_block(color_at, stride, pack_rgba8<N>(f.color));
+    pack_rgba8<N>(f.color).store(color_at);
     return;
   }
-  I old = simd::load_block<I>(color_at, stride);
+  I old = I::load(color_at);
   I packed = blend<N>(blend_mode, f.color, old);
-  simd::store_block(color_at, stride, simd::select(f.live, packed, old));
+  simd::select(f.live, packed, old).store(color_at);
 }
 
 template <class S, int N>
