@@ -17,6 +17,7 @@
 //
 // The fragment shaders here are scalar (`fragment()`): these pictures are a few thousand pixels,
 // and one instantiation per shader keeps this program quick to compile.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -177,22 +178,16 @@ void draw_lines(softrast::Framebuffer& fb, const std::vector<vec2>& ends, vec4 c
 
 uint32_t pack(vec4 c) { return softrast::pack_rgba8(c); }
 
-// `small` magnified `k` times with nearest filtering: each pixel a (k-1)-wide square, a one-pixel
-// grid line between pixels (brighter every `block` pixels when block > 0), and a dot at every
-// pixel centre (dark over a covered pixel, light over the background).
+// `small` magnified `k` times with nearest filtering: each pixel a (k-1)-wide square and a
+// one-pixel grid line between pixels (brighter every `block` pixels when block > 0).
 softrast::Framebuffer magnify(const softrast::Framebuffer& small, int k, int block) {
   softrast::Framebuffer big(small.width() * k + 1, small.height() * k + 1);
   big.clear_color({0.32f, 0.32f, 0.32f, 1.0f});
-  const uint32_t background = pack(kBackground);
   for (int y = 0; y < small.height(); ++y) {
     for (int x = 0; x < small.width(); ++x) {
       uint32_t c = small.color_at(x, y);
       for (int j = 1; j < k; ++j) {
         for (int i = 1; i < k; ++i) big.color_row(y * k + j)[x * k + i] = c;
-      }
-      uint32_t dot = c == background ? pack({0.6f, 0.6f, 0.6f, 1}) : pack({0.1f, 0.1f, 0.1f, 1});
-      for (int j = -1; j <= 1; ++j) {
-        for (int i = -1; i <= 1; ++i) big.color_row(y * k + k / 2 + j)[x * k + k / 2 + i] = dot;
       }
     }
   }
@@ -205,6 +200,21 @@ softrast::Framebuffer magnify(const softrast::Framebuffer& small, int k, int blo
     }
   }
   return big;
+}
+
+// A dot at every pixel centre of `small` on its magnification `big` (drawn last, so that a sample
+// on an edge shows on the edge's line): dark over a covered pixel, grey over the background.
+void draw_sample_dots(const softrast::Framebuffer& small, softrast::Framebuffer& big, int k) {
+  const uint32_t background = pack(kBackground);
+  for (int y = 0; y < small.height(); ++y) {
+    for (int x = 0; x < small.width(); ++x) {
+      bool empty = small.color_at(x, y) == background;
+      uint32_t dot = empty ? pack({0.55f, 0.55f, 0.55f, 1}) : pack({0.05f, 0.05f, 0.05f, 1});
+      for (int j = -1; j <= 1; ++j) {
+        for (int i = -1; i <= 1; ++i) big.color_row(y * k + k / 2 + j)[x * k + k / 2 + i] = dot;
+      }
+    }
+  }
 }
 
 // A window point of the small framebuffer on the magnified one (its grid line at x * k).
@@ -282,6 +292,7 @@ bool coverage_figure(const std::string& dir) {
       edges.push_back(on_big(pts[size_t(b)], kScale));
     }
     draw_lines(big, edges, kWhite);
+    draw_sample_dots(*f, big, kScale);
     panels.push_back(big.to_image());
   }
   return save(dir + "/coverage_top_left.png", side_by_side(panels, 16));
@@ -317,6 +328,7 @@ bool edge_walking_figure(const std::string& dir) {
   edges.push_back(on_big(on_long_edge, kWalkScale));
   edges.push_back(on_big(mid, kWalkScale));
   draw_lines(big, edges, kWhite);
+  draw_sample_dots(fb, big, kWalkScale);
   return save(dir + "/edge_walking.png", big.to_image());
 }
 
@@ -341,8 +353,19 @@ bool edge_equations_figure(const std::string& dir) {
   }
   std::printf("rasterizers: %d pixels covered, %d differ between edge equations and walking\n",
               covered, differ);
+  // Blocks with all 16 pixels covered: the ones the hierarchical test accepts whole.
+  int full_blocks = 0;
+  for (int by = 0; by + 4 <= kWalkH; by += 4) {
+    for (int bx = 0; bx + 4 <= kWalkW; bx += 4) {
+      bool full = true;
+      for (int i = 0; i < 16; ++i) full &= fb.color_at(bx + i % 4, by + i / 4) != pack(kBackground);
+      full_blocks += full;
+    }
+  }
+  std::printf("rasterizers: %d 4x4 blocks wholly covered\n", full_blocks);
   softrast::Framebuffer big = magnify(fb, kWalkScale, 4);
   draw_lines(big, walk_triangle_edges(), kWhite);
+  draw_sample_dots(fb, big, kWalkScale);
   return save(dir + "/edge_equations_blocks.png", big.to_image());
 }
 
@@ -352,8 +375,8 @@ bool perspective_figure(const std::string& dir) {
   std::vector<vec2> uv = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
   std::vector<uint32_t> indices = {0, 1, 2, 0, 2, 3};
   softrast::Camera camera;
-  camera.eye = {0.0f, 0.9f, 1.9f};
-  camera.target = {0.0f, 0.0f, -1.2f};
+  camera.eye = {0.0f, 1.5f, 2.3f};
+  camera.target = {0.0f, 0.0f, -1.4f};
   glm::mat4 mvp = camera.view_projection(float(kW) / float(kH));
   softrast::RenderState state;
   state.cull = softrast::CullMode::kNone;
@@ -376,7 +399,7 @@ bool perspective_figure(const std::string& dir) {
 bool clipping_figure(const std::string& dir) {
   constexpr int kW = 360, kH = 270;
   const float aspect = float(kW) / float(kH);
-  std::vector<vec3> pos = {{-1.2f, -0.6f, -4.0f}, {1.4f, -0.3f, -3.5f}, {0.2f, 0.35f, -0.8f}};
+  std::vector<vec3> pos = {{-1.6f, -0.9f, -3.4f}, {1.5f, -0.6f, -2.9f}, {0.1f, 0.45f, -0.7f}};
   std::vector<vec3> col = {{0.9f, 0.3f, 0.2f}, {0.2f, 0.8f, 0.3f}, {0.3f, 0.4f, 0.95f}};
   std::vector<uint32_t> tri = {0, 1, 2};
   softrast::Camera eye;  // at the origin, looking down -z
@@ -393,6 +416,14 @@ bool clipping_figure(const std::string& dir) {
   // made (RenderState::wireframe draws the edges of each triangle after clipping).
   softrast::Framebuffer seen(kW, kH);
   seen.clear(kBackground, 1.0f, 1);
+  // The whole triangle's outline in grey, as a camera with its near plane at 0.5 would see it
+  // (the same x and y; only depth differs): the part the clipper removes.
+  softrast::Camera nearer = eye;
+  nearer.near_plane = 0.5f;
+  std::vector<uint32_t> outline = {0, 1, 1, 2, 2, 0};
+  softrast::draw(seen, overlay_state(softrast::Primitive::kLines),
+                 FlatWorld{pos.data(), nearer.view_projection(aspect), {0.5f, 0.5f, 0.5f, 1}},
+                 outline, 3);
   softrast::draw(seen, state, NearTint{pos.data(), col.data(), eye_mvp, eye.view(), 0.0f}, tri,
                  3);
   softrast::RenderState wire = overlay_state(softrast::Primitive::kTriangles);
@@ -439,18 +470,22 @@ bool depth_figure(const std::string& dir) {
   softrast::render_mesh(fb, scene.mesh, scene.camera, options);
   // The stored window depth, linear grey: 0 (the near plane) black, 1 (far, or cleared) white.
   softrast::Image raw(kW, kH);
-  int above_09 = 0, drawn = 0;
+  std::vector<float> drawn;
   for (int y = 0; y < kH; ++y) {
     for (int x = 0; x < kW; ++x) {
       float d = fb.depth_at(x, y);
       uint8_t g = softrast::to_unorm8(d);
       uint8_t* p = raw.pixel(x, y);
       p[0] = p[1] = p[2] = g, p[3] = 255;
-      if (d < 1.0f) ++drawn, above_09 += d > 0.9f;
+      if (d < 1.0f) drawn.push_back(d);
     }
   }
-  std::printf("depth: %d of %d drawn pixels store a depth above 0.9 (near %.2f, far %.1f)\n",
-              above_09, drawn, scene.camera.near_plane, scene.camera.far_plane);
+  std::sort(drawn.begin(), drawn.end());
+  auto at = [&](double q) { return drawn.empty() ? 1.0f : drawn[size_t(q * double(drawn.size() - 1))]; };
+  std::printf("depth: %zu pixels drawn; stored depth min %.3f, 10%% %.3f, median %.3f, 90%% %.3f, "
+              "max %.3f (near %.2f, far %.1f)\n",
+              drawn.size(), at(0), at(0.1), at(0.5), at(0.9), at(1), scene.camera.near_plane,
+              scene.camera.far_plane);
   softrast::Framebuffer view(kW, kH);
   view.clear();
   options.shader = softrast::ShaderKind::kDepth;
