@@ -176,7 +176,9 @@ void draw_lines(softrast::Framebuffer& fb, const std::vector<vec2>& ends, vec4 c
   }
 }
 
-uint32_t pack(vec4 c) { return softrast::pack_rgba8(c); }
+uint32_t pack(vec4 c) {
+  return softrast::pack_rgba8(c);
+}
 
 // `small` magnified `k` times with nearest filtering: each pixel a (k-1)-wide square and a
 // one-pixel grid line between pixels (brighter every `block` pixels when block > 0).
@@ -218,12 +220,15 @@ void draw_sample_dots(const softrast::Framebuffer& small, softrast::Framebuffer&
 }
 
 // A window point of the small framebuffer on the magnified one (its grid line at x * k).
-vec2 on_big(vec2 p, int k) { return p * float(k) + 0.5f; }
+vec2 on_big(vec2 p, int k) {
+  return p * float(k) + 0.5f;
+}
 
 // Images side by side with `gap` pixels of white between them, tops aligned.
 softrast::Image side_by_side(const std::vector<softrast::Image>& images, int gap) {
   int width = -gap, height = 0;
-  for (const softrast::Image& im : images) width += im.width + gap, height = std::max(height, im.height);
+  for (const softrast::Image& im : images)
+    width += im.width + gap, height = std::max(height, im.height);
   softrast::Image out(width, height);
   std::fill(out.rgba.begin(), out.rgba.end(), uint8_t(255));
   int x0 = 0;
@@ -238,8 +243,10 @@ softrast::Image side_by_side(const std::vector<softrast::Image>& images, int gap
 
 bool save(const std::string& path, const softrast::Image& image) {
   softrast::Status s = softrast::save_image(path, image);
-  if (!s) std::fprintf(stderr, "softrast_docs_figures: %s\n", s.message().c_str());
-  else std::printf("wrote %s (%dx%d)\n", path.c_str(), image.width, image.height);
+  if (!s)
+    std::fprintf(stderr, "softrast_docs_figures: %s\n", s.message().c_str());
+  else
+    std::printf("wrote %s (%dx%d)\n", path.c_str(), image.width, image.height);
   return bool(s);
 }
 
@@ -280,9 +287,10 @@ bool coverage_figure(const std::string& dir) {
       once += hits == 1, twice += hits >= 2;
     }
   }
-  std::printf("coverage: upper-right triangle %d pixels, lower-left %d, pixels hit once %d, "
-              "hit twice %d\n",
-              count_color(fb, kOrange), count_color(fb, kBlue), once, twice);
+  std::printf(
+      "coverage: upper-right triangle %d pixels, lower-left %d, pixels hit once %d, "
+      "hit twice %d\n",
+      count_color(fb, kOrange), count_color(fb, kBlue), once, twice);
   std::vector<softrast::Image> panels;
   for (softrast::Framebuffer* f : {&fb, &count}) {
     softrast::Framebuffer big = magnify(*f, kScale, 0);
@@ -384,8 +392,7 @@ bool perspective_figure(const std::string& dir) {
   for (bool affine : {false, true}) {
     softrast::Framebuffer fb(kW, kH);
     fb.clear(kBackground, 1.0f, 1);
-    softrast::draw(fb, state, Checker{pos.data(), uv.data(), mvp, affine, 6.0f, 18.0f}, indices,
-                   4);
+    softrast::draw(fb, state, Checker{pos.data(), uv.data(), mvp, affine, 6.0f, 18.0f}, indices, 4);
     // The shared diagonal, where the affine picture bends.
     std::vector<vec3> diagonal = {pos[0], pos[2]};
     std::vector<uint32_t> line = {0, 1};
@@ -424,8 +431,7 @@ bool clipping_figure(const std::string& dir) {
   softrast::draw(seen, overlay_state(softrast::Primitive::kLines),
                  FlatWorld{pos.data(), nearer.view_projection(aspect), {0.5f, 0.5f, 0.5f, 1}},
                  outline, 3);
-  softrast::draw(seen, state, NearTint{pos.data(), col.data(), eye_mvp, eye.view(), 0.0f}, tri,
-                 3);
+  softrast::draw(seen, state, NearTint{pos.data(), col.data(), eye_mvp, eye.view(), 0.0f}, tri, 3);
   softrast::RenderState wire = overlay_state(softrast::Primitive::kTriangles);
   wire.wireframe = true;
   softrast::draw(seen, wire, FlatWorld{pos.data(), eye_mvp, kWhite}, tri, 3);
@@ -448,9 +454,12 @@ bool clipping_figure(const std::string& dir) {
   // The frustum's sides to z = -4.4 and its near plane, in the plane y = 0.
   const float half_w = std::tan(glm::radians(eye.fov_y_degrees / 2)) * aspect;
   const float z_end = -4.4f, n = eye.near_plane;
-  std::vector<vec3> frustum = {{0, 0, 0},           {-half_w * -z_end, 0, z_end},
-                               {0, 0, 0},           {half_w * -z_end, 0, z_end},
-                               {-half_w * n, 0, -n}, {half_w * n, 0, -n}};
+  std::vector<vec3> frustum = {{0, 0, 0},
+                               {-half_w * -z_end, 0, z_end},
+                               {0, 0, 0},
+                               {half_w * -z_end, 0, z_end},
+                               {-half_w * n, 0, -n},
+                               {half_w * n, 0, -n}};
   std::vector<uint32_t> lines = {0, 1, 2, 3, 4, 5};
   softrast::draw(top, overlay_state(softrast::Primitive::kLines),
                  FlatWorld{frustum.data(), top_mvp, {0.9f, 0.9f, 0.5f, 1}}, lines, 6);
@@ -481,11 +490,14 @@ bool depth_figure(const std::string& dir) {
     }
   }
   std::sort(drawn.begin(), drawn.end());
-  auto at = [&](double q) { return drawn.empty() ? 1.0f : drawn[size_t(q * double(drawn.size() - 1))]; };
-  std::printf("depth: %zu pixels drawn; stored depth min %.3f, 10%% %.3f, median %.3f, 90%% %.3f, "
-              "max %.3f (near %.2f, far %.1f)\n",
-              drawn.size(), at(0), at(0.1), at(0.5), at(0.9), at(1), scene.camera.near_plane,
-              scene.camera.far_plane);
+  auto at = [&](double q) {
+    return drawn.empty() ? 1.0f : drawn[size_t(q * double(drawn.size() - 1))];
+  };
+  std::printf(
+      "depth: %zu pixels drawn; stored depth min %.3f, 10%% %.3f, median %.3f, 90%% %.3f, "
+      "max %.3f (near %.2f, far %.1f)\n",
+      drawn.size(), at(0), at(0.1), at(0.5), at(0.9), at(1), scene.camera.near_plane,
+      scene.camera.far_plane);
   softrast::Framebuffer view(kW, kH);
   view.clear();
   options.shader = softrast::ShaderKind::kDepth;
