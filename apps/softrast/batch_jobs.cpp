@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "args.hpp"
+#include "parse_errors.hpp"
 #include "values.hpp"
 
 namespace softrast::cli {
@@ -241,7 +242,8 @@ Result<JobSpec> interpret_job(const std::string& text, const std::string& defaul
   try {
     app.parse(reversed);
   } catch (const CLI::ParseError& e) {
-    return Status::error(e.what());
+    const CLI::App* commands[] = {&app};
+    return Status::error(parse_error_message(commands, e));
   }
   return interpret(raw);
 }

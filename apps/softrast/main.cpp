@@ -24,6 +24,7 @@
 #include "args.hpp"
 #include "batch.hpp"
 #include "info.hpp"
+#include "parse_errors.hpp"
 #include "run.hpp"
 #include "sequence.hpp"
 #include "setup.hpp"
@@ -164,6 +165,9 @@ int render_command(const RawArgs& raw) {
 
 int run(int argc, char** argv) {
   CLI::App app{"softrast: a software rasterizer", "softrast"};
+  // Flags take no value: `--wireframe=5` is an error, not a quiet `true` (inherited by the
+  // subcommands, which copy the defaults when they are added).
+  app.option_defaults()->disable_flag_override();
   CLI::App* render = app.add_subcommand("render", "Render a model (or the demo scene) to an image");
   RawArgs raw;
   define_render_flags(*render, raw);
@@ -188,7 +192,8 @@ int run(int argc, char** argv) {
     return kExitUsage;
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    report_error(std::string(e.what()) + " (see softrast --help)");
+    const CLI::App* commands[] = {render, view, batch, info};
+    report_error(parse_error_message(commands, e) + " (see softrast --help)");
     return kExitUsage;
   }
   if (view->parsed()) return view_command(view_args, report_error);
