@@ -189,7 +189,7 @@ softrast::Framebuffer magnify(const softrast::Framebuffer& small, int k, int blo
     for (int x = 0; x < small.width(); ++x) {
       uint32_t c = small.color_at(x, y);
       for (int j = 1; j < k; ++j) {
-        for (int i = 1; i < k; ++i) big.color_row(y * k + j)[x * k + i] = c;
+        for (int i = 1; i < k; ++i) big.set_color(x * k + i, y * k + j, c);
       }
     }
   }
@@ -197,7 +197,7 @@ softrast::Framebuffer magnify(const softrast::Framebuffer& small, int k, int blo
     const uint32_t bright = pack({0.85f, 0.85f, 0.85f, 1});
     for (int y = 0; y < big.height(); ++y) {
       for (int x = 0; x < big.width(); ++x) {
-        if ((x % (k * block) == 0) || (y % (k * block) == 0)) big.color_row(y)[x] = bright;
+        if ((x % (k * block) == 0) || (y % (k * block) == 0)) big.set_color(x, y, bright);
       }
     }
   }
@@ -213,7 +213,7 @@ void draw_sample_dots(const softrast::Framebuffer& small, softrast::Framebuffer&
       bool empty = small.color_at(x, y) == background;
       uint32_t dot = empty ? pack({0.55f, 0.55f, 0.55f, 1}) : pack({0.05f, 0.05f, 0.05f, 1});
       for (int j = -1; j <= 1; ++j) {
-        for (int i = -1; i <= 1; ++i) big.color_row(y * k + k / 2 + j)[x * k + k / 2 + i] = dot;
+        for (int i = -1; i <= 1; ++i) big.set_color(x * k + k / 2 + i, y * k + k / 2 + j, dot);
       }
     }
   }

@@ -46,18 +46,23 @@ SOFTRAST_SIMD_INLINE simd::Int<N> wrap_texel(Wrap mode, const simd::Int<N>& i,
   return r;
 }
 
+// RGBA8 texels to channels in [0, 1].
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> unpack_texel(const simd::Int<N>& texel) {
+  using F = simd::Float<N>;
+  const F k(1.0f / 255.0f);
+  simd::Int<N> byte(0xff);
+  return {simd::to_float(texel & byte) * k, simd::to_float((texel >> 8) & byte) * k,
+          simd::to_float((texel >> 16) & byte) * k, simd::to_float(texel >> 24) * k};
+}
+
 // Texel (i, j) of the level whose size and first texel are (w, h, offset), lane by lane.
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> fetch(const Texture& t, const simd::Int<N>& i,
                                          const simd::Int<N>& j, const simd::Int<N>& w,
                                          const simd::Int<N>& offset) {
-  using F = simd::Float<N>;
-  simd::Int<N> texel =
-      simd::gather<N>(reinterpret_cast<const int32_t*>(t.texels()), offset + j * w + i);
-  const F k(1.0f / 255.0f);
-  simd::Int<N> byte(0xff);
-  return {simd::to_float(texel & byte) * k, simd::to_float((texel >> 8) & byte) * k,
-          simd::to_float((texel >> 16) & byte) * k, simd::to_float(texel >> 24) * k};
+  return unpack_texel<N>(
+      simd::gather<N>(reinterpret_cast<const int32_t*>(t.texels()), offset + j * w + i));
 }
 
 template <int N>
@@ -91,6 +96,17 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_level(const Texture& t, const Sampler&
   I i1 = wrap_texel<N>(s.wrap_u, x0 + one, w, pow2_u);
   I j0 = wrap_texel<N>(s.wrap_v, y0, h, pow2_v);
   I j1 = wrap_texel<N>(s.wrap_v, y0 + one, h, pow2_v);
+  if (simd::bits(i1 == i0 + one) == 0xffffu) {
+    // No lane wraps between its two columns: texels (i0, j) and (i1, j) are neighbours in memory,
+    // so one 64-bit load per lane and row fetches both (the same texels, half the loads).
+    const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
+    I b0, b1, t0, t1;
+    simd::gather_pair<N>(texels, offset + j0 * w + i0, b0, b1);
+    simd::gather_pair<N>(texels, offset + j1 * w + i0, t0, t1);
+    simd::Vec4<N> bottom = lerp<N>(unpack_texel<N>(b0), unpack_texel<N>(b1), fx);
+    simd::Vec4<N> top = lerp<N>(unpack_texel<N>(t0), unpack_texel<N>(t1), fx);
+    return lerp<N>(bottom, top, fy);
+  }
   simd::Vec4<N> bottom =
       lerp<N>(fetch<N>(t, i0, j0, w, offset), fetch<N>(t, i1, j0, w, offset), fx);
   simd::Vec4<N> top = lerp<N>(fetch<N>(t, i0, j1, w, offset), fetch<N>(t, i1, j1, w, offset), fx);
