@@ -47,11 +47,28 @@ class Framebuffer {
 
   Image to_image() const;
 
+  // Colour and depth per sample for multisampled draws (RenderState::samples > 1), `count`
+  // samples per pixel, pixel (x, y)'s at [(y * width + x) * count, ... + count). Kept between
+  // multisampled draws with the same count, so that triangles of different draws sharing an edge
+  // blend per sample; every draw leaves the pixels resolved (colour the rounded average of the
+  // samples, depth their minimum). `valid` is false until a multisampled draw fills the samples
+  // from the pixels; clears and single-sampled draws reset it. Code that writes pixels directly
+  // after a multisampled draw sets it to false too.
+  struct Multisample {
+    int count = 0;
+    bool valid = false;
+    std::vector<uint32_t> color;
+    std::vector<float> depth;
+  };
+  Multisample& multisample() { return multisample_; }
+  const Multisample& multisample() const { return multisample_; }
+
  private:
   int width_;
   int height_;
   std::vector<uint32_t> color_;
   std::vector<float> depth_;
+  Multisample multisample_;
 };
 
 // Float colour to RGBA8 by the conventions: clamp to [0, 1], then x * 255 + 0.5 truncated.
