@@ -58,7 +58,8 @@ detail::WindowVertex wv(int64_t x, int64_t y) {
 
 // Every sample of every pixel of random triangles whose vertices lie on the 1/16 pixel grid (so
 // that edges run exactly through sample points very often) is covered exactly when the oracle
-// of fill_rule_oracle.hpp, written from CONVENTIONS.md alone, says so; for both windings.
+// of fill_rule_oracle.hpp, written from CONVENTIONS.md alone, says so; for both windings, small
+// triangles (the 32-bit path) and large ones (int64).
 TEST(Msaa, PerSampleCoverageFollowsTheFillRule) {
   std::mt19937 rng(61);
   std::uniform_int_distribution<int> coord(-8 * 16, 24 * 16);  // in 1/16 pixel, around a 16x16 area
@@ -68,7 +69,11 @@ TEST(Msaa, PerSampleCoverageFollowsTheFillRule) {
     const SamplePattern& p = *standard_sample_pattern(n);
     for (int round = 0; round < 1500; ++round) {
       detail::WindowVertex v[3];
-      for (auto& w : v) w = wv(coord(rng) * 16, coord(rng) * 16);
+      // Every other triangle is up to 100 pixels across: past the 64-pixel bound of the 32-bit
+      // path, so both paths of the kernel are checked.
+      const int scale = round % 2 == 0 ? 1 : 6;
+      for (auto& w : v) w = wv((coord(rng) * scale - 40 * (scale - 1)) * 16,
+                               (coord(rng) * scale - 40 * (scale - 1)) * 16);
       if (round % 3 == 0) v[2] = wv(v[0].x, v[1].y);  // axis-aligned edges: top edges
       int64_t area = detail::signed_area_fx16(v[0], v[1], v[2]);
       if (area == 0) continue;

@@ -168,7 +168,8 @@ class TileShader {
   void write_samples(int px, int py, uint8_t samples, const float* z, float shader_depth,
                      uint32_t color, Framebuffer::Multisample& ms) const {
     size_t at = sample_index(px, py);
-    glm::vec4 src = unpack_rgba8(color);
+    const bool opaque = state_.blend == BlendMode::kOpaque;
+    glm::vec4 src = opaque ? glm::vec4(0.0f) : unpack_rgba8(color);
     for (int s = 0; s < pattern_.count; ++s) {
       if (!(samples >> s & 1)) continue;
       float depth = program_.writes_depth ? shader_depth : z[s];
@@ -179,7 +180,7 @@ class TileShader {
         if (state_.depth_write) ms.depth[at + s] = depth;
       }
       uint32_t& dst = ms.color[at + s];
-      dst = state_.blend == BlendMode::kOpaque ? color : blend_pixel(state_.blend, src, dst);
+      dst = opaque ? color : blend_pixel(state_.blend, src, dst);
     }
   }
 

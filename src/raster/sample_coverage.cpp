@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include <emmintrin.h>  // SSE2: every x86-64 has it
+
 #include "raster/raster.hpp"
 
 namespace softrast::detail {
@@ -38,6 +40,39 @@ uint32_t area_pixels(const PixelRect& area, int x, int y) {
   int r0 = std::clamp(area.y0 - y, 0, 4), r1 = std::clamp(area.y1 - y, 0, 4);
   if (c0 >= c1 || r0 >= r1) return 0;
   return block_rect_mask(c0, c1, r0, r1);
+}
+
+// The 32-bit path. For a triangle whose vertex extents W, H are at most S = kSmallTriangleFx8, a
+// block meeting the touched pixels has its samples within 5 pixels of the vertex extents (the
+// bounds reach up to a pixel past them, the block 3 pixels past the bounds, a sample 1 pixel into
+// its pixel), so with (xi, yi) a vertex of the edge, |px - xi| < W + 5 * 256 and likewise y:
+//   |E| <= |a| |px - xi| + |b| |py - yi| + 1 < 2 S (S + 1280) + 1 < 2^31,
+// and the steps across the block, (|a| + |b|) * 3 * 256, are smaller still.
+static_assert(2 * kSmallTriangleFx8 * (kSmallTriangleFx8 + 5 * kSubpixelOne) + 1 <
+                  (int64_t(1) << 31),
+              "32-bit sample edge functions overflow");
+
+// Bit c of the result: the sample of column c (value + c * step) passes (>= 0), for one row.
+inline uint32_t row_mask(int32_t value, int32_t step) {
+  __m128i v = _mm_add_epi32(_mm_set1_epi32(value), _mm_set_epi32(3 * step, 2 * step, step, 0));
+  return uint32_t(~_mm_movemask_ps(_mm_castsi128_ps(v))) & 0xfu;
+}
+
+// Coverage masks per sample of the partially covered block at (x, y): bit 4 * row + column of
+// masks[s], for the 32-bit path.
+void sample_masks_small(const SampleTriangle& tri, const SamplePattern& p, int x, int y,
+                        uint32_t masks[kMaxSamples]) {
+  for (int s = 0; s < p.count; ++s) masks[s] = 0xffffu;
+  for (const EdgeFunction& e : tri.edge) {
+    const int32_t step_x = int32_t(e.a * kSubpixelOne), step_y = int32_t(e.b * kSubpixelOne);
+    for (int s = 0; s < p.count; ++s) {
+      int32_t row = int32_t(e.at(int64_t(x) * kSubpixelOne + p.x[s],
+                                 int64_t(y) * kSubpixelOne + p.y[s]));
+      uint32_t m = 0;
+      for (int r = 0; r < 4; ++r, row += step_y) m |= row_mask(row, step_x) << (4 * r);
+      masks[s] &= m;
+    }
+  }
 }
 
 enum class BlockTest { kOutside, kInside, kPartial };
@@ -93,6 +128,10 @@ bool setup_sample_triangle(const WindowVertex& v0, const WindowVertex& v1, const
     int j = (k + 1) % 3;
     out.edge[k] = triangle_edge(out.vx[k], out.vy[k], out.vx[j], out.vy[j]);
   }
+  auto extent = [](const int32_t v[3]) {
+    return int64_t(std::max({v[0], v[1], v[2]})) - std::min({v[0], v[1], v[2]});
+  };
+  out.small = extent(out.vx) <= kSmallTriangleFx8 && extent(out.vy) <= kSmallTriangleFx8;
   return true;
 }
 
@@ -105,6 +144,18 @@ uint32_t block_sample_coverage(const SampleTriangle& tri, const SamplePattern& p
   if (test == BlockTest::kInside) {
     for (int i = 0; i < 16; ++i) cov[i] = (pixels >> i & 1) ? all : 0;
     return pixels;
+  }
+  if (tri.small) {
+    uint32_t masks[kMaxSamples];
+    sample_masks_small(tri, pattern, x, y, masks);
+    uint32_t mask = 0;
+    for (int i = 0; i < 16; ++i) {
+      uint32_t c = 0;
+      for (int s = 0; s < pattern.count; ++s) c |= (masks[s] >> i & 1u) << s;
+      cov[i] = (pixels >> i & 1) ? uint8_t(c) : 0;
+      mask |= uint32_t(cov[i] != 0) << i;
+    }
+    return mask;
   }
   for (int i = 0; i < 16; ++i) cov[i] = (pixels >> i & 1) ? all : 0;
   for (const EdgeFunction& e : tri.edge) {

@@ -32,6 +32,9 @@ struct SampleTriangle {
   int32_t vy[3] = {0, 0, 0};
   EdgeFunction edge[3];
   PixelRect bounds;
+  // Vertex extents of at most kSmallTriangleFx8 (64 pixels) in x and y: every edge function value
+  // at the samples of a block that meets `bounds` fits in int32 (sample_coverage.cpp).
+  bool small = false;
 };
 
 // Sets up the coverage of the triangle whose snapped signed area (signed_area_fx16) is `area`
