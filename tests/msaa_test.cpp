@@ -29,10 +29,9 @@ using detail::standard_sample_pattern;
 TEST(Msaa, StandardSamplePositions) {
   const double k2[][2] = {{0.75, 0.75}, {0.25, 0.25}};
   const double k4[][2] = {{0.375, 0.125}, {0.875, 0.375}, {0.125, 0.625}, {0.625, 0.875}};
-  const double k8[][2] = {{0.5625, 0.3125}, {0.4375, 0.6875}, {0.8125, 0.5625},
-                          {0.3125, 0.1875}, {0.1875, 0.8125}, {0.0625, 0.4375},
-                          {0.6875, 0.9375}, {0.9375, 0.0625}};
-  auto check = [](int n, const double (*table)[2]) {
+  const double k8[][2] = {{0.5625, 0.3125}, {0.4375, 0.6875}, {0.8125, 0.5625}, {0.3125, 0.1875},
+                          {0.1875, 0.8125}, {0.0625, 0.4375}, {0.6875, 0.9375}, {0.9375, 0.0625}};
+  auto check = [](int n, const double(*table)[2]) {
     const SamplePattern* p = standard_sample_pattern(n);
     ASSERT_NE(p, nullptr);
     ASSERT_EQ(p->count, n);
@@ -72,8 +71,9 @@ TEST(Msaa, PerSampleCoverageFollowsTheFillRule) {
       // Every other triangle is up to 100 pixels across: past the 64-pixel bound of the 32-bit
       // path, so both paths of the kernel are checked.
       const int scale = round % 2 == 0 ? 1 : 6;
-      for (auto& w : v) w = wv((coord(rng) * scale - 40 * (scale - 1)) * 16,
-                               (coord(rng) * scale - 40 * (scale - 1)) * 16);
+      for (auto& w : v)
+        w = wv((coord(rng) * scale - 40 * (scale - 1)) * 16,
+               (coord(rng) * scale - 40 * (scale - 1)) * 16);
       if (round % 3 == 0) v[2] = wv(v[0].x, v[1].y);  // axis-aligned edges: top edges
       int64_t area = detail::signed_area_fx16(v[0], v[1], v[2]);
       if (area == 0) continue;
@@ -93,14 +93,14 @@ TEST(Msaa, PerSampleCoverageFollowsTheFillRule) {
               expect |= uint8_t(test::rule_covers(oracle, sx, sy)) << s;
               for (int k = 0; k < 3; ++k) {
                 int j = (k + 1) % 3;
-                on_edge += test::cross_fx(oracle.x[k], oracle.y[k], oracle.x[j], oracle.y[j], sx,
-                                          sy) == 0;
+                on_edge +=
+                    test::cross_fx(oracle.x[k], oracle.y[k], oracle.x[j], oracle.y[j], sx, sy) == 0;
               }
             }
             uint8_t got = (mask >> i & 1) ? cov[i] : 0;
-            ASSERT_EQ(got, expect) << n << "x, pixel " << px << "," << py << ", triangle ("
-                                   << v[0].x << "," << v[0].y << ") (" << v[1].x << "," << v[1].y
-                                   << ") (" << v[2].x << "," << v[2].y << ")";
+            ASSERT_EQ(got, expect)
+                << n << "x, pixel " << px << "," << py << ", triangle (" << v[0].x << "," << v[0].y
+                << ") (" << v[1].x << "," << v[1].y << ") (" << v[2].x << "," << v[2].y << ")";
             ++checked;
           }
         }
@@ -137,8 +137,8 @@ TEST(Msaa, OneCentreSampleEqualsThePixelRasterizer) {
       for (int by = 0; by < 32; by += 4) {
         for (int bx = 0; bx < 32; bx += 4) {
           uint8_t cov[16];
-          sample[size_t(by / 4 * 8 + bx / 4)] =
-              detail::block_sample_coverage(tri, *standard_sample_pattern(1), tri.bounds, bx, by, cov);
+          sample[size_t(by / 4 * 8 + bx / 4)] = detail::block_sample_coverage(
+              tri, *standard_sample_pattern(1), tri.bounds, bx, by, cov);
         }
       }
     }
@@ -302,7 +302,6 @@ TEST(Msaa, RotatedSquareEdgeMatchesAnalyticArea) {
     EXPECT_LE(std::abs(e4.total), 160.0 / 10.0 / 8.0);
     EXPECT_GT(e1.mean_abs, 1.0 / 8.0);
     EdgeError e8 = rotated_square_error(8, degrees);
-    std::printf("%g deg: 1x %.4f 4x %.4f 8x %.4f, total 4x %.3f px, %d edge pixels\n", degrees, e1.mean_abs, e4.mean_abs, e8.mean_abs, e4.total, e4.edge_pixels);
     EXPECT_LT(e8.mean_abs, e4.mean_abs);
   }
 }

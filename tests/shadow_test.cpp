@@ -39,10 +39,10 @@ Mesh cube_on_plane() {
   const float e = kHalfExtent;
   add_quad(m, {-e, 0, e}, {e, 0, e}, {e, 0, -e}, {-e, 0, -e}, {0, 1, 0});
   const float h = 0.5f;
-  add_quad(m, {-h, 1, h}, {h, 1, h}, {h, 1, -h}, {-h, 1, -h}, {0, 1, 0});    // top
-  add_quad(m, {-h, 0, h}, {h, 0, h}, {h, 1, h}, {-h, 1, h}, {0, 0, 1});      // +z
+  add_quad(m, {-h, 1, h}, {h, 1, h}, {h, 1, -h}, {-h, 1, -h}, {0, 1, 0});     // top
+  add_quad(m, {-h, 0, h}, {h, 0, h}, {h, 1, h}, {-h, 1, h}, {0, 0, 1});       // +z
   add_quad(m, {h, 0, -h}, {-h, 0, -h}, {-h, 1, -h}, {h, 1, -h}, {0, 0, -1});  // -z
-  add_quad(m, {h, 0, h}, {h, 0, -h}, {h, 1, -h}, {h, 1, h}, {1, 0, 0});      // +x
+  add_quad(m, {h, 0, h}, {h, 0, -h}, {h, 1, -h}, {h, 1, h}, {1, 0, 0});       // +x
   add_quad(m, {-h, 0, -h}, {-h, 0, h}, {-h, 1, h}, {-h, 1, -h}, {-1, 0, 0});  // -x
   return m;
 }
@@ -111,7 +111,9 @@ ShadowCheck check_light(glm::vec3 light) {
   Image with = render(mesh, light, true), without = render(mesh, light, false);
   glm::dvec3 l = glm::normalize(glm::dvec3(light));
   ShadowCheck c;
-  auto red = [](const Image& im, int x, int y) { return int(im.rgba[(size_t(y) * kSize + x) * 4]); };
+  auto red = [](const Image& im, int x, int y) {
+    return int(im.rgba[(size_t(y) * kSize + x) * 4]);
+  };
   // Shadowed: nearer the ambient light alone (0.15 of the white albedo) than the lit value.
   auto dark = [&](int x, int y) { return 2 * red(with, x, y) < 38 + red(without, x, y); };
   for (int y = 0; y < kSize; ++y) {
@@ -160,8 +162,8 @@ ShadowCheck check_light(glm::vec3 light) {
 }
 
 TEST(Shadows, CubeOnPlaneCastsItsAnalyticShadow) {
-  const glm::vec3 lights[] = {{0.5f, 1.0f, 0.3f}, {-0.8f, 0.6f, 0.4f}, {0.3f, 0.9f, -0.7f},
-                              {1.0f, 0.5f, 0.0f}};
+  const glm::vec3 lights[] = {
+      {0.5f, 1.0f, 0.3f}, {-0.8f, 0.6f, 0.4f}, {0.3f, 0.9f, -0.7f}, {1.0f, 0.5f, 0.0f}};
   for (glm::vec3 light : lights) {
     SCOPED_TRACE("light " + std::to_string(light.x) + "," + std::to_string(light.y) + "," +
                  std::to_string(light.z));

@@ -15,7 +15,8 @@ namespace {
 // (-6,2), (2,6)).
 constexpr SamplePattern kPattern1{1, {128}, {128}};
 constexpr SamplePattern kPattern2{2, {12 * 16, 4 * 16}, {12 * 16, 4 * 16}};
-constexpr SamplePattern kPattern4{4, {6 * 16, 14 * 16, 2 * 16, 10 * 16}, {2 * 16, 6 * 16, 10 * 16, 14 * 16}};
+constexpr SamplePattern kPattern4{
+    4, {6 * 16, 14 * 16, 2 * 16, 10 * 16}, {2 * 16, 6 * 16, 10 * 16, 14 * 16}};
 constexpr SamplePattern kPattern8{
     8,
     {9 * 16, 7 * 16, 13 * 16, 5 * 16, 3 * 16, 1 * 16, 11 * 16, 15 * 16},
@@ -66,8 +67,8 @@ void sample_masks_small(const SampleTriangle& tri, const SamplePattern& p, int x
   for (const EdgeFunction& e : tri.edge) {
     const int32_t step_x = int32_t(e.a * kSubpixelOne), step_y = int32_t(e.b * kSubpixelOne);
     for (int s = 0; s < p.count; ++s) {
-      int32_t row = int32_t(e.at(int64_t(x) * kSubpixelOne + p.x[s],
-                                 int64_t(y) * kSubpixelOne + p.y[s]));
+      int32_t row =
+          int32_t(e.at(int64_t(x) * kSubpixelOne + p.x[s], int64_t(y) * kSubpixelOne + p.y[s]));
       uint32_t m = 0;
       for (int r = 0; r < 4; ++r, row += step_y) m |= row_mask(row, step_x) << (4 * r);
       masks[s] &= m;
@@ -161,8 +162,8 @@ uint32_t block_sample_coverage(const SampleTriangle& tri, const SamplePattern& p
   for (const EdgeFunction& e : tri.edge) {
     const int64_t step_x = e.a * kSubpixelOne, step_y = e.b * kSubpixelOne;
     for (int s = 0; s < pattern.count; ++s) {
-      int64_t row = e.at(int64_t(x) * kSubpixelOne + pattern.x[s],
-                         int64_t(y) * kSubpixelOne + pattern.y[s]);
+      int64_t row =
+          e.at(int64_t(x) * kSubpixelOne + pattern.x[s], int64_t(y) * kSubpixelOne + pattern.y[s]);
       const uint8_t bit = uint8_t(1u << s);
       for (int r = 0; r < 4; ++r, row += step_y) {
         int64_t value = row;

@@ -20,17 +20,18 @@ namespace softrast::detail {
 // The light's depth image: window depth (0 nearest the light) of the nearest surface per texel,
 // seen through an orthographic projection fitted to the scene's bounding box.
 struct ShadowMap {
-  int size = 0;                // texels per side
-  std::vector<float> depth;    // size * size, row 0 at the top, 1 where nothing was drawn
-  glm::mat4 light_vp{1.0f};    // world -> the light's clip space (orthographic, w = 1)
-  float texel_depth = 0.0f;    // a texel's world size in window-depth units
+  int size = 0;              // texels per side
+  std::vector<float> depth;  // size * size, row 0 at the top, 1 where nothing was drawn
+  glm::mat4 light_vp{1.0f};  // world -> the light's clip space (orthographic, w = 1)
+  float texel_depth = 0.0f;  // a texel's world size in window-depth units
   // Bias in texels' worth of depth: kConstantBias + kSlopeBias * tan(angle of incidence). The
   // slope term covers the depth change of a surface across the 3x3 filter (the farthest tap's
   // centre is 1.5 texels from the receiver) plus the half texel between the receiver and the
   // centre its depth was sampled at; the constant covers float rounding of both depths.
   static constexpr float kConstantBias = 1.0f;
   static constexpr float kSlopeBias = 2.5f;
-  static constexpr float kMaxSlope = 10.0f;  // tan of about 84 degrees: grazing light is unlit anyway
+  static constexpr float kMaxSlope =
+      10.0f;  // tan of about 84 degrees: grazing light is unlit anyway
 };
 
 // Draws `mesh` (both faces) from the direction `towards_light` into a size x size depth image.
@@ -41,8 +42,7 @@ ShadowMap build_shadow_map(const Mesh& mesh, glm::vec3 towards_light, int size, 
 // texels around p's texel whose stored depth is not nearer than p's depth minus the bias.
 // Points outside the map are lit.
 template <int N>
-SOFTRAST_SIMD_INLINE simd::Float<N> shadow_visibility(const ShadowMap& map,
-                                                      const simd::Vec3<N>& p,
+SOFTRAST_SIMD_INLINE simd::Float<N> shadow_visibility(const ShadowMap& map, const simd::Vec3<N>& p,
                                                       const simd::Float<N>& cos_incidence) {
   using F = simd::Float<N>;
   const glm::mat4& m = map.light_vp;
@@ -68,7 +68,8 @@ SOFTRAST_SIMD_INLINE simd::Float<N> shadow_visibility(const ShadowMap& map,
     }
     int tx = int(us[i]), ty = int(vs[i]), lit = 0;
     for (int dy = -1; dy <= 1; ++dy) {
-      const float* row = &map.depth[size_t(std::clamp(ty + dy, 0, map.size - 1)) * size_t(map.size)];
+      const float* row =
+          &map.depth[size_t(std::clamp(ty + dy, 0, map.size - 1)) * size_t(map.size)];
       for (int dx = -1; dx <= 1; ++dx) lit += rs[i] <= row[std::clamp(tx + dx, 0, map.size - 1)];
     }
     out[i] = float(lit) * (1.0f / 9.0f);
