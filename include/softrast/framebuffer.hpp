@@ -52,8 +52,9 @@ class Framebuffer {
   // multisampled draws with the same count, so that triangles of different draws sharing an edge
   // blend per sample; every draw leaves the pixels resolved (colour the rounded average of the
   // samples, depth their minimum). `valid` is false until a multisampled draw fills the samples
-  // from the pixels; clears and single-sampled draws reset it. Code that writes pixels directly
-  // after a multisampled draw sets it to false too.
+  // from the pixels; clear_color, clear_depth and single-sampled draws reset it, and
+  // clear(colour, depth, threads) clears the samples with the pixels. Code that writes pixels
+  // directly after a multisampled draw sets it to false too.
   struct Multisample {
     int count = 0;
     bool valid = false;
