@@ -389,7 +389,8 @@ TEST_F(CliTest, HelpMentionsEveryFlag) {
           "--cull",   "--front-face", "--depth",  "--blend",     "--alpha",   "--raster",
           "--filter", "--wrap",       "--frames", "--threads",   "--quiet",   "--help",
           "--light",  "--version",    "-o",       "MODEL",       "flat",      "gouraud",
-          "phong",    "normals",      "scanline", "notequal",    "mirror"}) {
+          "phong",    "normals",      "scanline", "notequal",    "mirror",    "--msaa",
+          "--shadows"}) {
       EXPECT_NE(r.out.find(flag), std::string::npos) << args << " does not mention " << flag;
     }
   }
@@ -465,6 +466,13 @@ TEST_F(CliTest, UnknownFlagSuggestsTheClosestOne) {
             "softrast --help)\n");
   CliRun far = run("quad.obj --bogus -o out.png");
   EXPECT_EQ(far.err, "softrast: error: unknown flag '--bogus' (see softrast --help)\n");
+  EXPECT_EQ(files(), kFixtures);
+}
+
+TEST_F(CliTest, MsaaNamesTheSampleCounts) {
+  CliRun r = run("quad.obj --msaa 3 -o out.png");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "softrast: error: --msaa: must be 1, 2, 4 or 8, got 3\n");
   EXPECT_EQ(files(), kFixtures);
 }
 
@@ -698,6 +706,8 @@ const BadInput kBadInputs[] = {
     {"NegativeThreads", "--threads -1 -o out.png"},
     {"NonNumericThreads", "--threads many -o out.png"},
     {"UnknownFilter", "--filter anisotropic -o out.png"},
+    {"MsaaThree", "--msaa 3 -o out.png"},
+    {"MsaaNotANumber", "--msaa many -o out.png"},
     {"UnknownWrap", "--wrap border -o out.png"},
     {"FramesZero", "--frames 0 -o out.png"},
     {"FramesNegative", "--frames=-2 -o out.png"},

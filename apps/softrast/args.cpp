@@ -102,6 +102,9 @@ void define_shading_flags(CLI::App& app, RawArgs& a) {
   app.add_option("--filter", a.filter,
                  "Texture filter: nearest, bilinear or trilinear (mipmapped) (default bilinear)")
       ->type_name("MODE");
+  app.add_flag("--shadows", a.shadows,
+               "Shadows of the directional light for phong: a depth map from the light over the "
+               "model's bounds, 3x3 percentage-closer filtering, slope-scaled bias");
   app.add_option("--wrap", a.wrap, "Texture wrap: repeat, clamp or mirror (default repeat)")
       ->type_name("MODE");
   app.add_option("--debug", a.debug, kDebugViewHelp)->type_name("VIEW");
@@ -123,6 +126,10 @@ void define_state_flags(CLI::App& app, RawArgs& a) {
       ->type_name("MODE");
   app.add_option("--raster", a.raster, "Rasterizer: edge (tiles) or scanline (default edge)")
       ->type_name("ALGO");
+  app.add_option("--msaa", a.msaa,
+                 "Multisample anti-aliasing: 1, 2, 4 or 8 samples per pixel at the standard "
+                 "D3D/Vulkan positions, shaded once per pixel and triangle (default 1)")
+      ->type_name("N");
   app.add_option("--threads", a.threads,
                  "Threads to render with: 0 for every core (default 0; the image is the same)")
       ->type_name("N");

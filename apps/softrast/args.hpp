@@ -35,6 +35,8 @@ struct RawArgs {
   std::string raster = "edge";
   int threads = 0;
   bool reference_path = false;
+  int msaa = 1;          // samples per pixel (RenderState::samples)
+  bool shadows = false;  // shadow map of the light (RenderOptions::shadows)
   std::string filter = "bilinear";
   std::string wrap = "repeat";
   std::optional<int> frames;

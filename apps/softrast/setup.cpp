@@ -122,6 +122,9 @@ void interpret_state(const RawArgs& a, RenderState& state, FirstError& e) {
             "--threads: must be in 0.." + std::to_string(kMaxThreads));
   state.threads = a.threads;
   state.reference_path = a.reference_path;
+  e.fail_if(a.msaa != 1 && a.msaa != 2 && a.msaa != 4 && a.msaa != 8,
+            "--msaa: must be 1, 2, 4 or 8, got " + std::to_string(a.msaa));
+  state.samples = a.msaa;
 }
 
 void interpret_shading(const RawArgs& a, RenderOptions& options, FirstError& e) {
@@ -153,6 +156,7 @@ void interpret_shading(const RawArgs& a, RenderOptions& options, FirstError& e) 
   }
   e.fail_if(!in_unit_range(a.alpha), "--alpha: must be in [0, 1]");
   options.alpha = a.alpha;
+  options.shadows = a.shadows;
   e.take(lookup<Filter>("--filter", kFilters, a.filter), options.sampler.filter);
   e.take(lookup<Wrap>("--wrap", kWraps, a.wrap), options.sampler.wrap_u);
   e.take(debug_view_named("--debug", a.debug), options.debug_view);

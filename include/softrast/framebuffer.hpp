@@ -100,6 +100,23 @@ class Framebuffer {
   // The depth of every pixel, row by row, top row first.
   std::vector<float> depth_values() const;
 
+  // Colour and depth per sample for multisampled draws (RenderState::samples > 1), `count`
+  // samples per pixel, pixel (x, y)'s at [(y * width + x) * count, ... + count). Kept between
+  // multisampled draws with the same count, so that triangles of different draws sharing an edge
+  // blend per sample; every draw leaves the pixels resolved (colour the rounded average of the
+  // samples, depth their minimum). `valid` is false until a multisampled draw fills the samples
+  // from the pixels; clear_color, clear_depth and single-sampled draws reset it, and
+  // clear(colour, depth, threads) clears the samples with the pixels. Code that writes pixels
+  // directly after a multisampled draw sets it to false too.
+  struct Multisample {
+    int count = 0;
+    bool valid = false;
+    std::vector<uint32_t> color;
+    std::vector<float> depth;
+  };
+  Multisample& multisample() { return multisample_; }
+  const Multisample& multisample() const { return multisample_; }
+
  private:
   template <class T>
   struct AlignedDelete {
@@ -130,6 +147,7 @@ class Framebuffer {
   bool any_pending_ = false;
   uint32_t pending_color_ = 0;
   float pending_depth_ = 1.0f;
+  Multisample multisample_;
 };
 
 // Float colour to RGBA8 by the conventions: clamp to [0, 1], then x * 255 + 0.5 truncated.

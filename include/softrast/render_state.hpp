@@ -59,6 +59,13 @@ struct RenderState {
   // overlay drawn over its own filled triangles keeps every pixel while hidden edges stay hidden.
   float polygon_offset_factor = 0.0f;
   float polygon_offset_units = 0.0f;
+  // Samples per pixel for filled triangles: 1, 2, 4 or 8 (other values draw as 1). Above 1, each
+  // triangle's coverage and depth are tested per sample at the standard Direct3D / Vulkan sample
+  // positions, the fragment shader runs once per pixel and covered triangle (at the pixel
+  // centre), its colour goes to the covered samples that pass the depth test, and the pixels are
+  // the samples' average (see Framebuffer::multisample). Lines, points and wireframe are drawn
+  // single-sampled. 1 is the single-sampled path, bit for bit.
+  int samples = 1;
   // Threads a draw may use: 0 for every hardware thread. The image is the same for every value.
   int threads = 0;
   // The slow, obviously correct oracle: one thread, every primitive set up, rasterized and shaded

@@ -49,6 +49,12 @@ struct RenderOptions {
   // Back-facing triangles (drawn when state.cull is not kBack) are lit with their normal
   // flipped, so an open or single-sided surface looks the same from both sides.
   bool two_sided_lighting = true;
+  // Shadows of the light (light_direction, a directional light) for the phong shader: the mesh
+  // is first drawn from the light into a shadow_map_size^2 depth map fitted to its bounds; the
+  // diffuse and specular terms are multiplied by the fraction of the 3x3 map texels around each
+  // pixel that see it (percentage-closer filtering, with a slope-scaled depth bias).
+  bool shadows = false;
+  int shadow_map_size = 2048;
   // Draws the culled triangle edges over the shaded mesh as well (hidden edges stay hidden).
   bool wireframe_overlay = false;
   glm::vec3 wire_color{0.05f, 0.05f, 0.05f};

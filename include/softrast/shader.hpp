@@ -84,6 +84,7 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
   detail::ClipVertices vertices{out, vertex_count, kStride, S::kVaryings};
   detail::FragmentProgram program;
   program.shader = &shader;
+  program.writes_depth = detail::WritesDepth<S>;
   if constexpr (detail::WideShader<S>) {
     program.shade_block = detail::wide_shade_block<S>(simd_level());
     program.deferrable = !detail::WritesDepth<S> && !detail::DeclaresDiscards<S>;

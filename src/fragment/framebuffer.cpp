@@ -26,7 +26,8 @@ Framebuffer::Framebuffer(const Framebuffer& other)
       pending_(other.pending_),
       any_pending_(other.any_pending_),
       pending_color_(other.pending_color_),
-      pending_depth_(other.pending_depth_) {
+      pending_depth_(other.pending_depth_),
+      multisample_(other.multisample_) {
   color_ = allocate<uint32_t>(size_);
   depth_ = allocate<float>(size_);
   std::memcpy(color_.get(), other.color_.get(), size_ * sizeof(uint32_t));
@@ -49,11 +50,13 @@ Result<Framebuffer> Framebuffer::create(int width, int height) {
 
 void Framebuffer::clear_color(glm::vec4 color) {
   write_pending_clears(1);  // the depth of pending tiles is still to be written
+  multisample_.valid = false;
   std::fill(color_.get(), color_.get() + size_, pack_rgba8(color));
 }
 
 void Framebuffer::clear_depth(float depth) {
   write_pending_clears(1);
+  multisample_.valid = false;
   std::fill(depth_.get(), depth_.get() + size_, depth);
 }
 
@@ -62,6 +65,7 @@ void Framebuffer::clear(glm::vec4 color, float depth) {
   pending_depth_ = depth;
   std::fill(pending_.begin(), pending_.end(), uint8_t(1));
   any_pending_ = true;
+  multisample_.valid = false;  // a multisampled draw fills its samples from the pixels again
 }
 
 void Framebuffer::fill_tile(size_t tile) {

@@ -7,6 +7,8 @@
 #include <cmath>
 
 #include "pipeline/draw_internal.hpp"
+#include "pipeline/multisample_draw.hpp"
+#include "raster/sample_coverage.hpp"
 #include "softrast/detail/parallel.hpp"
 #include "softrast/framebuffer.hpp"
 
@@ -133,6 +135,13 @@ void draw_clip_space(Framebuffer& framebuffer, const RenderState& state,
   GeometryStage geometry(framebuffer.width(), framebuffer.height(), state, vertices);
   ShadeTarget target{&framebuffer, &state};
   int threads = state.threads > 0 ? state.threads : hardware_threads();
+  bool filled = state.primitive == Primitive::kTriangles && !state.wireframe;
+  if (state.samples > 1 && standard_sample_pattern(state.samples) && filled) {
+    draw_triangles_multisample(framebuffer, geometry, state, program, indices, index_count,
+                               threads);
+    return;
+  }
+  framebuffer.multisample().valid = false;  // the pixels change under the samples
   if (!state.reference_path && state.primitive == Primitive::kTriangles && !state.wireframe) {
     draw_triangles_binned(geometry, state, target, program, indices, index_count, threads);
     return;

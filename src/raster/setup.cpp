@@ -134,6 +134,10 @@ bool setup_triangle(const WindowVertex& v0, const WindowVertex& v1, const Window
   return true;
 }
 
+EdgeFunction triangle_edge(int32_t xi, int32_t yi, int32_t xj, int32_t yj) {
+  return make_edge(xi, yi, xj, yj);
+}
+
 bool setup_line(const WindowVertex& v0, const WindowVertex& v1, int num_varyings,
                 const PixelRect& scissor, LineSetup& out) {
   int64_t dx = int64_t(v1.x) - v0.x, dy = int64_t(v1.y) - v0.y;

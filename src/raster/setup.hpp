@@ -94,6 +94,11 @@ bool setup_triangle_coverage(const WindowVertex& v0, const WindowVertex& v1, con
 void setup_triangle_interpolants(const WindowVertex* const ordered[3], int num_varyings,
                                  int64_t area, FrontFace front_face, Interpolants& out);
 
+// The edge function of the edge from (xi, yi) to (xj, yj) of a clockwise triangle (1/256 pixel),
+// with the top-left rule in c: the edges setup_triangle makes, for rasterizers that test other
+// sample positions than the pixel centres (multisampling).
+EdgeFunction triangle_edge(int32_t xi, int32_t yi, int32_t xj, int32_t yj);
+
 // A line segment after snapping, with its interpolants (gradients along the major axis only).
 struct LineSetup {
   int32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // 1/256 pixel

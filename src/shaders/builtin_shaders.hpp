@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
 
+#include "shaders/shadow_map.hpp"
 #include "softrast/mesh.hpp"
 #include "softrast/shader.hpp"
 #include "softrast/texture.hpp"
@@ -31,6 +32,7 @@ struct Lighting {
   // Back-facing primitives are lit with their normal flipped (two-sided lighting), so a
   // single-sided surface seen from behind looks as it does from the front.
   bool two_sided = false;
+  const ShadowMap* shadow = nullptr;  // phong: diffuse and specular times the light's visibility
 };
 
 // Inputs shared by the built-in shaders.
@@ -136,8 +138,10 @@ struct PhongShader {
     F s = simd::select(d > F(0.0f), pow_shininess(simd::max(simd::dot(n, h), F(0.0f))), F(0.0f));
     simd::Vec4<N> base{F(albedo.r), F(albedo.g), F(albedo.b), F(1.0f)};
     if (texture) base = sample_with_derivatives(*texture, sampler, f, 6);
-    F lit = F(lighting.ambient) + F(lighting.diffuse) * d;
-    F spec = F(lighting.specular) * s;
+    F visible = lighting.shadow ? shadow_visibility<N>(*lighting.shadow, f.vec3(0), simd::dot(n, l))
+                                : F(1.0f);
+    F lit = F(lighting.ambient) + F(lighting.diffuse) * d * visible;
+    F spec = F(lighting.specular) * s * visible;
     f.color = {base.x * lit + spec, base.y * lit + spec, base.z * lit + spec, base.w * alpha};
   }
   // x^32 by five squarings (kShininess is 32).

@@ -57,11 +57,13 @@ detail::Lighting lighting_of(const RenderOptions& opt) {
 // Draws one run of indices with the chosen built-in shader.
 void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const Camera& camera,
               const glm::mat4& mvp, std::span<const uint32_t> indices, const Surface& surf,
-              const RenderOptions& opt, ShaderKind kind, DepthRange depth) {
+              const RenderOptions& opt, ShaderKind kind, DepthRange depth,
+              const detail::ShadowMap* shadow = nullptr) {
   using namespace detail;
   MeshInputs in{&mesh, mvp};
   uint32_t n = uint32_t(mesh.positions.size());
   Lighting lighting = lighting_of(opt);
+  lighting.shadow = shadow;
   // Two-sided Gouraud interpolates a second colour; only worth it when back faces are drawn.
   bool two_sided = lighting.two_sided && state.cull != CullMode::kBack;
   static const Texture kWhite;  // samples as opaque white
@@ -180,10 +182,16 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
     depth = visible_depth_range(framebuffer.width(), framebuffer.height(), mesh, camera, mvp, runs,
                                 state);
   }
+  std::optional<detail::ShadowMap> shadow;
+  if (options.shadows && options.shader == ShaderKind::kPhong) {
+    shadow = detail::build_shadow_map(mesh, options.light_direction, options.shadow_map_size,
+                                      options.state.threads);
+  }
   for (const SubMesh& run : runs) {
     std::span<const uint32_t> indices(mesh.indices.data() + run.first_index, run.index_count);
     Surface surf = surface_of(mesh, run.material, options);
-    draw_run(framebuffer, state, mesh, camera, mvp, indices, surf, options, options.shader, depth);
+    draw_run(framebuffer, state, mesh, camera, mvp, indices, surf, options, options.shader, depth,
+             shadow ? &*shadow : nullptr);
   }
   if (options.wireframe_overlay && options.shader != ShaderKind::kWireframe) {
     RenderState wire = options.state;

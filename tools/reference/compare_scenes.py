@@ -5,9 +5,10 @@ against the figures of SCENES.md, and the median frame time of each (the median 
 medians) for each thread count: softrast --threads N beside llvmpipe with LP_NUM_THREADS=N.
 
 usage: compare_scenes.py [--scenes DIR] [--models DIR] [--build DIR] [--out DIR] [--runs N]
-                         [--threads 1,2] [--only NAME[,NAME...]] [--all]
+                         [--threads 1,2] [--only NAME[,NAME...]] [--all] [--extra "FLAGS"]
 By default it runs the rows of the speed issue's table (each with its target ratio); --all adds
-the other SCENES.md cases (flat shading, textured spheres).
+the other SCENES.md cases (flat shading, textured spheres); --extra adds flags that both
+renderers take to every run (e.g. --extra "--msaa 4").
 Build first with: cmake --preset release -DSOFTRAST_BUILD_REFERENCE=ON && cmake --build --preset
 release. Scenes: python3 ../shared/bench/gen_scenes.py DIR (the default DIR is /tmp/scenes).
 """
@@ -72,6 +73,7 @@ def main():
     parser.add_argument("--only", default="")
     parser.add_argument("--models", default=os.path.join(os.path.dirname(root), "shared", "models"))
     parser.add_argument("--all", action="store_true")
+    parser.add_argument("--extra", default="")
     args = parser.parse_args()
     softrast = os.path.join(args.build, "softrast")
     glref = os.path.join(args.build, "tools", "reference", "glref")
@@ -94,6 +96,7 @@ def main():
             texture = "%s/checker.png" % args.scenes
         flags = [model, "--size", "1920x1080"]
         flags += CAMERAS[scene].split() + ["--shader", shader, "--light", "0.3,0.5,0.8", "-q"]
+        flags += args.extra.split()
         if textured:
             flags += ["--texture", texture]
         soft_png = os.path.join(args.out, name + "_softrast.png")

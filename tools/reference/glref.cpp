@@ -80,6 +80,7 @@ struct Options {
   float alpha = 1.0f;
   std::string cull = "none", front_face = "ccw", depth = "less", blend = "opaque";
   int frames = 0;
+  int msaa = 1;  // samples per pixel: above 1, a multisample framebuffer resolved by a blit
   std::optional<int> threads;
   std::optional<std::string> out;
   bool quiet = false;
@@ -102,6 +103,8 @@ constexpr const char* kHelp =
     "                      softrast does); --front-face ccw|cw (ccw)\n"
     "  --depth FUNC        less, lequal, equal, greater, gequal, notequal, always, never, off\n"
     "  --blend MODE        opaque, alpha or add (opaque)\n"
+    "  --msaa N            1, 2, 4 or 8 samples per pixel: a multisample framebuffer object,\n"
+    "                      resolved into the image by glBlitFramebuffer in every frame (1)\n"
     "  --frames N          time N frames after 2 warm-ups; one JSON line on stdout\n"
     "  --threads N         set LP_NUM_THREADS (default: as in the environment)\n"
     "  -q, --quiet         no messages on stderr\n";
@@ -213,6 +216,9 @@ bool apply_flag(const std::string& flag, const std::string& value, Options& o) {
     o.frames = parse_int(flag, value, 1, 1000000);
   } else if (flag == "--threads") {
     o.threads = parse_int(flag, value, 0, 1024);
+  } else if (flag == "--msaa") {
+    check_choice(flag, value, {"1", "2", "4", "8"});
+    o.msaa = std::stoi(value);
   } else {
     return false;
   }
@@ -705,11 +711,54 @@ void set_state(const Options& o) {
   check_gl("set_state");
 }
 
+// With --msaa above 1: a framebuffer object with multisample RGBA8 colour and 24-bit depth
+// renderbuffers that frames draw into, and the samples the implementation gave it.
+struct MultisampleTarget {
+  GLuint fbo = 0;
+  int width = 0, height = 0;
+};
+MultisampleTarget g_msaa;
+
+void make_multisample_target(const Options& o) {
+  if (o.msaa <= 1) return;
+  GLuint buffers[2];
+  glGenRenderbuffers(2, buffers);
+  glBindRenderbuffer(GL_RENDERBUFFER, buffers[0]);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, o.msaa, GL_RGBA8, o.width, o.height);
+  glBindRenderbuffer(GL_RENDERBUFFER, buffers[1]);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, o.msaa, GL_DEPTH_COMPONENT24, o.width,
+                                   o.height);
+  glGenFramebuffers(1, &g_msaa.fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, g_msaa.fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, buffers[0]);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, buffers[1]);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    failure("the " + std::to_string(o.msaa) + "x multisample framebuffer is incomplete");
+  }
+  GLint samples = 0;
+  glGetIntegerv(GL_SAMPLES, &samples);
+  if (samples != o.msaa) {
+    failure("asked for " + std::to_string(o.msaa) + " samples, got " + std::to_string(samples));
+  }
+  glEnable(GL_MULTISAMPLE);
+  g_msaa.width = o.width;
+  g_msaa.height = o.height;
+  check_gl("make_multisample_target");
+}
+
 // One frame as SCENES.md defines it: clear colour and depth, one draw, glFinish. Milliseconds.
+// Multisampled: the samples are resolved into the image (glBlitFramebuffer) before glFinish.
 double render_frame(const Mesh& mesh) {
   auto start = std::chrono::steady_clock::now();
+  if (g_msaa.fbo) glBindFramebuffer(GL_FRAMEBUFFER, g_msaa.fbo);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glDrawElements(GL_TRIANGLES, GLsizei(mesh.indices.size()), GL_UNSIGNED_INT, nullptr);
+  if (g_msaa.fbo) {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, g_msaa.fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glBlitFramebuffer(0, 0, g_msaa.width, g_msaa.height, 0, 0, g_msaa.width, g_msaa.height,
+                      GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
   glFinish();
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
@@ -798,6 +847,7 @@ int run(int argc, char** argv) {
   upload_texture(o.texture);
   set_uniforms(make_program(o.shader), o);
   set_state(o);
+  make_multisample_target(o);
 
   if (o.frames > 0) {
     for (int i = 0; i < kWarmupFrames; ++i) render_frame(mesh);

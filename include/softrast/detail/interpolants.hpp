@@ -64,6 +64,7 @@ struct FragmentProgram {
   ShadeBlockFn shade_block = nullptr;
   const void* shader = nullptr;
   bool deferrable = false;
+  bool writes_depth = false;  // the shader sets the depth (late depth test)
 };
 
 // The vertex stage's output: per vertex a clip-space position (x, y, z, w) followed by
