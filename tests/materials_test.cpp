@@ -93,7 +93,7 @@ TEST(Materials, MtlStatementsAndMapsAreRead) {
   EXPECT_EQ(m.normal_map->color_space(), ColorSpace::kLinear);
   EXPECT_EQ(m.normal_space, NormalSpace::kTangent);
   EXPECT_EQ(m.normal_scale, 0.5f);  // -bm on a normal map scales its slope in the shader
-  EXPECT_EQ(m.normal_map->texel(0, 0), glm::vec4(128, 160, 230, 255) / 255.0f);
+  EXPECT_EQ(glm::round(m.normal_map->texel(0, 0) * 255.0f), glm::vec4(128, 160, 230, 255));
   // A material that says nothing about its highlight keeps SCENES.md's.
   const Material& plain = mesh->materials[1];
   EXPECT_EQ(plain.specular, glm::vec3(0.4f));
