@@ -120,12 +120,12 @@ struct TextureShader {
 
 // What phong reads of a material (renderer.cpp fills it from Material and RenderOptions).
 struct SurfaceMaps {
-  const Texture* diffuse = nullptr;   // albedo (and alpha) from here when set
-  const Texture* specular = nullptr;  // rgb multiplies specular_color
-  const Texture* normal = nullptr;    // the shading normal from here when set
-  bool object_space = false;          // the normal map's space (else tangent space)
-  float normal_scale = 1.0f;          // scales the map's x and y
-  const Texture* alpha = nullptr;     // red multiplies the alpha
+  const Texture* diffuse = nullptr;     // albedo (and alpha) from here when set
+  const Texture* specular = nullptr;    // rgb multiplies specular_color
+  const Texture* normal = nullptr;      // the shading normal from here when set
+  bool object_space = false;            // the normal map's space (else tangent space)
+  float normal_scale = 1.0f;            // scales the map's x and y
+  const Texture* alpha = nullptr;       // red multiplies the alpha
   glm::vec3 specular_color{kSpecular};  // Ks times the light intensity
   float shininess = kShininess;
   float opacity = 1.0f;
@@ -164,8 +164,8 @@ struct PhongShader {
     using F = simd::Float<N>;
     simd::Vec3<N> n = simd::normalize(f.vec3(3));
     if (maps.normal) {
-      simd::Vec3<N> m = map_normal<N>(sample_with_derivatives(*maps.normal, sampler, f, 6),
-                                      maps.normal_scale);
+      simd::Vec3<N> m =
+          map_normal<N>(sample_with_derivatives(*maps.normal, sampler, f, 6), maps.normal_scale);
       if (maps.object_space) {
         n = simd::normalize(m);
       } else if constexpr (kTangents) {
