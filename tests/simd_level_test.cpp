@@ -147,11 +147,11 @@ template <>
   expect_sampler_matches_scalar<16>(t, s, uvs);
 }
 
-Texture noise_texture(int width, int height, unsigned seed) {
+Texture noise_texture(int width, int height, unsigned seed, bool srgb = false) {
   std::mt19937 rng(seed);
   Image image(width, height);
   for (uint8_t& b : image.rgba) b = uint8_t(rng());
-  return Texture::from_image(image);
+  return Texture::from_image(image, srgb ? ColorSpace::kSrgb : ColorSpace::kLinear);
 }
 
 TEST(SimdSampler, MatchesScalarSamplingBitForBitAtEveryLevel) {
@@ -166,18 +166,22 @@ TEST(SimdSampler, MatchesScalarSamplingBitForBitAtEveryLevel) {
     for (int i = 0; i < 16; ++i) uvs.push_back({special, near_range(rng)});
   }
   for (auto [w, h] : {std::pair{64, 32}, std::pair{37, 19}, std::pair{1, 1}, std::pair{256, 5}}) {
-    Texture texture = noise_texture(w, h, unsigned(w * 100 + h));
-    for (Filter filter : {Filter::kNearest, Filter::kBilinear, Filter::kTrilinear}) {
-      for (Wrap wrap : {Wrap::kRepeat, Wrap::kClampToEdge, Wrap::kMirroredRepeat}) {
-        Sampler sampler{filter, wrap, wrap};
-        SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + " filter " +
-                     std::to_string(int(filter)) + " wrap " + std::to_string(int(wrap)));
-        check_sampler_at_native_width<4>(texture, sampler, uvs);
-        if (cpu_simd_level() >= SimdLevel::kAvx2) {
-          check_sampler_at_native_width<8>(texture, sampler, uvs);
-        }
-        if (cpu_simd_level() >= SimdLevel::kAvx512) {
-          check_sampler_at_native_width<16>(texture, sampler, uvs);
+    for (bool srgb : {false, true}) {
+      // An sRGB texture read through the decode table (its chain built in linear space).
+      Texture texture = noise_texture(w, h, unsigned(w * 100 + h), srgb);
+      for (Filter filter : {Filter::kNearest, Filter::kBilinear, Filter::kTrilinear}) {
+        for (Wrap wrap : {Wrap::kRepeat, Wrap::kClampToEdge, Wrap::kMirroredRepeat}) {
+          Sampler sampler{filter, wrap, wrap, srgb};
+          SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + " filter " +
+                       std::to_string(int(filter)) + " wrap " + std::to_string(int(wrap)) +
+                       (srgb ? " srgb" : ""));
+          check_sampler_at_native_width<4>(texture, sampler, uvs);
+          if (cpu_simd_level() >= SimdLevel::kAvx2) {
+            check_sampler_at_native_width<8>(texture, sampler, uvs);
+          }
+          if (cpu_simd_level() >= SimdLevel::kAvx512) {
+            check_sampler_at_native_width<16>(texture, sampler, uvs);
+          }
         }
       }
     }

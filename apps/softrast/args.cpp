@@ -85,6 +85,18 @@ void define_shading_flags(CLI::App& app, RawArgs& a) {
                  "Direction towards the light, fixed in world space (default: a headlight, "
                  "0.3,0.5,0.8 in the camera's frame, so any view is lit from its upper right)")
       ->type_name("X,Y,Z");
+  app.add_option("--light-pos", a.light_pos,
+                 "A point light at this position in world space instead of a direction (lights "
+                 "every point from where it is, with no fall-off; not with --light)")
+      ->type_name("X,Y,Z");
+  app.add_option("--maps", a.maps,
+                 "Which of the model's maps phong uses: all (diffuse, specular, normal, alpha), "
+                 "diffuse (only the colour maps, the plain textured look), none (default all)")
+      ->type_name("WHICH");
+  app.add_flag("--srgb", a.srgb,
+               "Linear workflow: colour textures decoded from sRGB (mipmaps built in linear "
+               "space), light computed in linear space, the image encoded to sRGB (default off: "
+               "colours read and written as stored)");
   app.add_option("--ambient", a.ambient,
                  "Ambient light of gouraud and phong, 0 to 1 (default 0.15)")
       ->type_name("A");
@@ -99,8 +111,11 @@ void define_shading_flags(CLI::App& app, RawArgs& a) {
   app.add_option("--background", a.background,
                  "Background colour, alpha 0 for a transparent PNG (default 0.1,0.1,0.1,1)")
       ->type_name("R,G,B[,A]");
-  app.add_option("--filter", a.filter,
-                 "Texture filter: nearest, bilinear or trilinear (mipmapped) (default bilinear)")
+  app.add_option(
+         "--filter", a.filter,
+         "Texture filter: nearest, bilinear or trilinear (mipmapped: bilinear in the two mip "
+         "levels nearest the level of detail, blended; no shimmer where the texture is "
+         "minified) (default bilinear)")
       ->type_name("MODE");
   app.add_flag("--shadows", a.shadows,
                "Shadows of the directional light for phong: a depth map from the light over the "

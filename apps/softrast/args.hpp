@@ -24,6 +24,9 @@ struct RawArgs {
   std::optional<std::string> texture;
   std::optional<std::string> color;
   std::optional<std::string> light;
+  std::optional<std::string> light_pos;  // a point light's position
+  std::string maps = "all";              // which material maps phong uses
+  bool srgb = false;                     // the linear workflow (sRGB textures and output)
   std::optional<float> ambient, light_intensity;
   std::optional<std::string> edge_color;
   std::optional<std::string> background;

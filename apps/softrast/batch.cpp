@@ -156,7 +156,8 @@ using TexturePtr = std::shared_ptr<const Texture>;
 Result<TexturePtr> read_texture(const std::string& path) {
   Result<Image> image = load_image(path);
   if (!image) return image.status();
-  return TexturePtr(std::make_shared<Texture>(Texture::from_image(*image)));
+  // A colour texture, as `softrast render --texture` reads it: sRGB data.
+  return TexturePtr(std::make_shared<Texture>(Texture::from_image(*image, ColorSpace::kSrgb)));
 }
 
 // The texels and their mip chain (a third more).

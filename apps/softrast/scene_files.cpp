@@ -99,6 +99,12 @@ Status append_mesh(Mesh& scene, const Mesh& part) {
   scene.positions.insert(scene.positions.end(), part.positions.begin(), part.positions.end());
   scene.normals.insert(scene.normals.end(), part.normals.begin(), part.normals.end());
   scene.uvs.insert(scene.uvs.end(), part.uvs.begin(), part.uvs.end());
+  // Tangents only while every part has them (else the renderer computes them if needed).
+  if (scene.tangents.size() == base && part.tangents.size() == part.positions.size()) {
+    scene.tangents.insert(scene.tangents.end(), part.tangents.begin(), part.tangents.end());
+  } else {
+    scene.tangents.clear();
+  }
   scene.materials.insert(scene.materials.end(), part.materials.begin(), part.materials.end());
   for (uint32_t i : part.indices) scene.indices.push_back(uint32_t(base) + i);
   if (part.submeshes.empty()) {

@@ -83,6 +83,10 @@ constexpr std::array<Named<Filter>, 3> kFilters = {{{"nearest", Filter::kNearest
                                                     {"trilinear", Filter::kTrilinear}}};
 constexpr std::array<Named<Wrap>, 3> kWraps = {
     {{"repeat", Wrap::kRepeat}, {"clamp", Wrap::kClampToEdge}, {"mirror", Wrap::kMirroredRepeat}}};
+constexpr std::array<Named<RenderOptions::Maps>, 3> kMapChoices = {
+    {{"all", RenderOptions::Maps::kAll},
+     {"diffuse", RenderOptions::Maps::kDiffuse},
+     {"none", RenderOptions::Maps::kNone}}};
 constexpr std::array<ShaderKind, 7> kShaderKinds = {
     ShaderKind::kFlat,    ShaderKind::kGouraud, ShaderKind::kTexture,  ShaderKind::kPhong,
     ShaderKind::kNormals, ShaderKind::kDepth,   ShaderKind::kWireframe};
@@ -140,6 +144,15 @@ void interpret_shading(const RawArgs& a, RenderOptions& options, FirstError& e) 
     e.fail_if(!(glm::length(options.light_direction) > 1.0e-6f),
               "--light: the direction must not be zero, got '" + *a.light + "'");
   }
+  if (a.light_pos) {
+    glm::vec3 position(0.0f);
+    e.take(parse_vec3("--light-pos", *a.light_pos), position);
+    e.fail_if(a.light.has_value(),
+              "--light-pos: a point light has no direction; give --light or --light-pos, not both");
+    options.light_position = position;
+  }
+  e.take(lookup<RenderOptions::Maps>("--maps", kMapChoices, a.maps), options.maps);
+  options.srgb = a.srgb;
   if (a.ambient) {
     e.fail_if(!in_unit_range(*a.ambient), "--ambient: must be in [0, 1]");
     options.ambient = *a.ambient;
@@ -278,7 +291,9 @@ Status check_output_path(const std::string& path) {
 Result<std::shared_ptr<const Texture>> load_texture(const std::string& path) {
   Result<Image> image = load_image(path);
   if (!image) return image.status();
-  return std::shared_ptr<const Texture>(std::make_shared<Texture>(Texture::from_image(*image)));
+  // A colour texture: sRGB data (decoded only with --srgb).
+  return std::shared_ptr<const Texture>(
+      std::make_shared<Texture>(Texture::from_image(*image, ColorSpace::kSrgb)));
 }
 
 double milliseconds_since(std::chrono::steady_clock::time_point start) {
@@ -348,7 +363,7 @@ Result<JobSpec> interpret(const RawArgs& args) {
   if (!e.status().ok()) return e.status();
   spec.models = args.models;
   spec.texture = args.texture;
-  spec.headlight = !args.light;
+  spec.headlight = !args.light && !args.light_pos;
   if (args.models.empty()) {
     e.fail_if(args.up_axis != "+y" || args.view || args.azimuth || args.elevation || args.zoom,
               "--up-axis, --view, --azimuth, --elevation and --zoom frame a model; the demo "

@@ -48,6 +48,9 @@ for part in african_head african_head_eye_inner; do
     >"$tmp/head/$part.mtl"
 done
 
+# ONLY=materials renders only the materials section at the end (the images above stay as they
+# were rendered for their own section).
+if [ "${ONLY:-all}" != materials ]; then
 # After: this tree.
 $new $head --texture "$head_tex" --view back $size -o "$out/head_back_after.png"
 $new $head --texture "$head_tex" --view right $size -o "$out/head_side_after.png"
@@ -73,3 +76,22 @@ if [ -n "$old" ]; then
     -o "$out/half_sphere_before.png"
   $old "$tmp/diablo_z_up.obj" --texture "$diablo_tex" $size -o "$out/z_up_before.png"
 fi
+fi  # ONLY
+
+# Materials (issue 6): the real models with every map by the plain command (the maps of the
+# tutorial convention, <model>_diffuse/_spec/_nm_tangent.tga, found beside the OBJ), the same with
+# --maps diffuse, a point light, and the demo scene's far floor without and with mipmaps.
+hd=$models/african_head
+msize="--size 320x320 -q"
+$new "$hd/african_head.obj" "$hd/african_head_eye_inner.obj" "$hd/african_head_eye_outer.obj" \
+  $msize -o "$out/materials_head.png"
+$new "$hd/african_head.obj" "$hd/african_head_eye_inner.obj" "$hd/african_head_eye_outer.obj" \
+  --maps diffuse $msize -o "$out/materials_head_diffuse.png"
+$new "$models/diablo3_pose/diablo3_pose.obj" $msize -o "$out/materials_diablo.png"
+$new "$models/diablo3_pose/diablo3_pose.obj" --maps diffuse $msize \
+  -o "$out/materials_diablo_diffuse.png"
+$new "$models/diablo3_pose/diablo3_pose.obj" --light-pos 0.6,0.4,0.7 $msize \
+  -o "$out/materials_diablo_point.png"
+$new "$models/diablo3_pose/diablo3_pose.obj" --srgb $msize -o "$out/materials_diablo_srgb.png"
+$new --filter bilinear --size 480x270 -q -o "$out/demo_floor_bilinear.png"
+$new --filter trilinear --size 480x270 -q -o "$out/demo_floor_trilinear.png"

@@ -16,10 +16,27 @@
 
 namespace softrast {
 
+// How a normal map's texels (rgb * 2 - 1 = xyz) are meant: in the surface's tangent frame
+// (MikkTSpace: x along the tangent, y along the bitangent, z the vertex normal; needs
+// Mesh::tangents), or in the model's own coordinates (object space).
+enum class NormalSpace { kTangent, kObject };
+
+// A surface's look for the built-in lit shaders (Blinn-Phong): colour = diffuse * (ambient +
+// diffuse light) + specular * highlight^shininess. The defaults are SCENES.md's (albedo A,
+// specular 0.4, shininess 32), so a model that says nothing looks as it always has.
 struct Material {
   std::string name;
-  glm::vec3 diffuse{0.9f, 0.6f, 0.3f};         // Kd; the default is SCENES.md's albedo A
-  std::shared_ptr<const Texture> diffuse_map;  // map_Kd, or null
+  glm::vec3 diffuse{0.9f, 0.6f, 0.3f};  // Kd; the default is SCENES.md's albedo A
+  glm::vec3 specular{0.4f};             // Ks, times the light intensity
+  float shininess = 32.0f;              // Ns, the Blinn-Phong exponent, in [0, 1000]
+  float opacity = 1.0f;                 // d (or 1 - Tr), multiplies the output alpha
+  // Maps, each null when absent. Colour maps (diffuse) are ColorSpace::kSrgb textures.
+  std::shared_ptr<const Texture> diffuse_map;   // map_Kd, or <model>_diffuse.tga: rgb and alpha
+  std::shared_ptr<const Texture> specular_map;  // map_Ks, or <model>_spec.tga: rgb multiplies Ks
+  std::shared_ptr<const Texture> normal_map;    // norm, map_Bump/bump, <model>_nm[_tangent].tga
+  NormalSpace normal_space = NormalSpace::kTangent;
+  float normal_scale = 1.0f;                 // -bm: scales the map's x and y (its slope)
+  std::shared_ptr<const Texture> alpha_map;  // map_d: its red channel multiplies the alpha
 };
 
 // A run of indices drawn with one material.
@@ -60,11 +77,16 @@ inline constexpr int64_t kMaxObjFileBytes = int64_t(2) << 30;
 // Largest MTL file load_obj reads: 64 MiB, far beyond any real material library.
 inline constexpr int64_t kMaxMtlFileBytes = int64_t(64) << 20;
 
-// Loads a Wavefront OBJ (polygons fan-triangulated) with its MTL libraries (Kd and map_Kd at
-// least); v, vt, vn, f, usemtl and mtllib are read, other statements skipped. Texture paths are
-// relative to the MTL file, MTL paths to the OBJ. A missing MTL leaves its materials undefined
-// (their faces get the default material) and a missing or unreadable map_Kd leaves its material
-// untextured; both add a line to Mesh::warnings:
+// Loads a Wavefront OBJ (polygons fan-triangulated) with its MTL libraries (Kd, Ks, Ns, d or Tr,
+// map_Kd, map_Ks, map_d, and norm, map_Bump or bump with -bm as tangent-space normal maps; a
+// greyscale bump map is a height map, turned into a normal map); v, vt, vn, f, usemtl and
+// mtllib are read, other statements skipped. Texture paths are relative to the MTL file, MTL
+// paths to the OBJ. An OBJ with no materials at all takes the maps of the tutorial models'
+// convention beside it, when they exist: <model>_diffuse.tga, <model>_spec.tga, and
+// <model>_nm_tangent.tga (tangent space) or else <model>_nm.tga (object space), as one material
+// named after the model. A material with a tangent-space normal map gets Mesh::tangents. A missing
+// MTL leaves its materials undefined (their faces get the default material) and a missing or
+// unreadable map_Kd leaves its material untextured; both add a line to Mesh::warnings:
 //   "model.obj:1: material library 'model.mtl' not found; its materials get the default colour"
 //   "model.obj: material 'skin': map_Kd: skin.png: cannot open: No such file or directory; drawn
 //    without this texture"  (the second part is load_image's message)

@@ -42,6 +42,17 @@ struct RenderOptions {
   std::shared_ptr<const Texture> texture;
   Sampler sampler;
   glm::vec3 light_direction{0.3f, 0.5f, 0.8f};  // towards the light, world space; normalised
+  // A point light at this world position instead of the directional light (no fall-off with
+  // distance: the light's strength is light_intensity everywhere).
+  std::optional<glm::vec3> light_position;
+  // Which of the materials' maps phong uses: every map, or only the diffuse ones (the look of
+  // a plain textured model, as OpenGL's reference renders it), or none.
+  enum class Maps { kAll, kDiffuse, kNone };
+  Maps maps = Maps::kAll;
+  // Linear workflow: colour textures (ColorSpace::kSrgb) decoded to linear, light computed in
+  // linear space, the output encoded to sRGB. Off (the default): everything read and written as
+  // stored, today's images.
+  bool srgb = false;
   // The lit shaders (gouraud, phong) shade albedo * (ambient + 0.85 * light_intensity * n.l)
   // plus, for phong, 0.4 * light_intensity * the Blinn-Phong highlight. SCENES.md: 0.15 and 1.
   float ambient = 0.15f;

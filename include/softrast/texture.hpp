@@ -21,11 +21,26 @@ namespace softrast {
 enum class Filter { kNearest, kBilinear, kTrilinear };
 enum class Wrap { kRepeat, kClampToEdge, kMirroredRepeat };
 
+// How a texture's bytes encode its values: kLinear reads byte / 255; kSrgb is colour data
+// stored with the sRGB transfer function (as images usually are), whose mip chain is built in
+// linear space and which samplers with srgb_decode read as linear (GL_SRGB8_ALPHA8: alpha is
+// always linear).
+enum class ColorSpace { kLinear, kSrgb };
+
 struct Sampler {
   Filter filter = Filter::kBilinear;
   Wrap wrap_u = Wrap::kRepeat;
   Wrap wrap_v = Wrap::kRepeat;
+  // Decode kSrgb textures to linear before filtering (GL_DECODE_EXT). Off: their bytes read as
+  // byte / 255, as a kLinear texture's do (GL_SKIP_DECODE_EXT; the default, today's look).
+  bool srgb_decode = false;
 };
+
+// The sRGB transfer function and its inverse (IEC 61966-2-1), exact (std::pow).
+float srgb_to_linear(float c);
+float linear_to_srgb(float c);
+// srgb_to_linear(k / 255) for k = 0..255, as floats (the decode table of kSrgb textures).
+const float* srgb_decode_table();
 
 // One level of a mip chain: its size and where its texels start (in texels).
 struct MipLevel {
@@ -57,11 +72,20 @@ class Texture {
  public:
   Texture() = default;
   // Takes an image as stored in a file (top row first) and flips it so that v = 0 is its bottom.
-  static Texture from_image(const Image& image);
+  // `space` says how the bytes encode colour; kSrgb builds the mip chain in linear space.
+  static Texture from_image(const Image& image, ColorSpace space = ColorSpace::kLinear);
+  // A texture whose mip chain is given, not built: levels[k] is level k as stored in a file and
+  // must be max(width >> k, 1) x max(height >> k, 1), down to 1x1 (else it aborts: a contract).
+  // For pre-filtered chains, and for tests that tell the levels apart.
+  static Texture from_mip_levels(const std::vector<Image>& levels,
+                                 ColorSpace space = ColorSpace::kLinear);
 
   int width() const { return width_; }
   int height() const { return height_; }
   bool empty() const { return texels_.empty(); }
+  ColorSpace color_space() const { return space_; }
+  // Whether sampler `s` reads this texture through the sRGB decode.
+  bool decodes(const Sampler& s) const { return s.srgb_decode && space_ == ColorSpace::kSrgb; }
   // The texels, rows bottom-up, RGBA8 (width * height * 4 bytes).
   const uint8_t* texels() const { return texels_.data(); }
   // Texel (i, j), j counted from the bottom row; precondition: in range.
@@ -113,15 +137,21 @@ class Texture {
  private:
   glm::vec4 sample_nearest(const Sampler& s, glm::vec2 uv, int level) const;
   glm::vec4 sample_bilinear(const Sampler& s, glm::vec2 uv, int level) const;
-  glm::vec4 level_texel(const MipLevel& l, int i, int j) const {
+  glm::vec4 level_texel(const MipLevel& l, int i, int j, bool decode) const {
     const uint8_t* t = &texels_[(l.offset + size_t(j) * size_t(l.width) + size_t(i)) * 4];
     constexpr float k = 1.0f / 255.0f;
+    if (decode) {
+      const float* d = srgb_decode_table();
+      return {d[t[0]], d[t[1]], d[t[2]], t[3] * k};
+    }
     return {t[0] * k, t[1] * k, t[2] * k, t[3] * k};
   }
 
   static std::vector<MipLevel> mip_levels(int width, int height);
   void downsample(const MipLevel& from, const MipLevel& to);
+  void downsample_srgb(const MipLevel& from, const MipLevel& to);
 
+  ColorSpace space_ = ColorSpace::kLinear;
   int width_ = 0;
   int height_ = 0;
   std::vector<uint8_t> texels_;  // every level, rows bottom-up, RGBA8
@@ -167,7 +197,7 @@ inline glm::vec4 Texture::sample_nearest(const Sampler& s, glm::vec2 uv, int lev
   float unused;
   int i = wrap(s.wrap_u, texel_floor(uv.x * float(l.width), unused), l.width);
   int j = wrap(s.wrap_v, texel_floor(uv.y * float(l.height), unused), l.height);
-  return level_texel(l, i, j);
+  return level_texel(l, i, j, decodes(s));
 }
 
 inline glm::vec4 Texture::sample_bilinear(const Sampler& s, glm::vec2 uv, int level) const {
@@ -179,8 +209,9 @@ inline glm::vec4 Texture::sample_bilinear(const Sampler& s, glm::vec2 uv, int le
   int y0 = texel_floor(uv.y * float(l.height) - 0.5f, fy);
   int i0 = wrap(s.wrap_u, x0, l.width), i1 = wrap(s.wrap_u, x0 + 1, l.width);
   int j0 = wrap(s.wrap_v, y0, l.height), j1 = wrap(s.wrap_v, y0 + 1, l.height);
-  glm::vec4 bottom = level_texel(l, i0, j0) * (1.0f - fx) + level_texel(l, i1, j0) * fx;
-  glm::vec4 top = level_texel(l, i0, j1) * (1.0f - fx) + level_texel(l, i1, j1) * fx;
+  bool d = decodes(s);
+  glm::vec4 bottom = level_texel(l, i0, j0, d) * (1.0f - fx) + level_texel(l, i1, j0, d) * fx;
+  glm::vec4 top = level_texel(l, i0, j1, d) * (1.0f - fx) + level_texel(l, i1, j1, d) * fx;
   return bottom * (1.0f - fy) + top * fy;
 }
 

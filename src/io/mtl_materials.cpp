@@ -1,17 +1,21 @@
 // io/mtl_materials.cpp: MTL libraries through tinyobj's LoadMtl (see mtl_materials.hpp).
-// tinyobj cannot tell a missing Kd from Kd 0 0 0, so which materials had one is scanned here.
+// tinyobj cannot tell a missing Kd, Ks or Ns from a zero, so which materials had one is scanned
+// here. Also the tutorial models' maps beside an OBJ without materials.
 
 #include "io/mtl_materials.hpp"
 
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string_view>
 #include <system_error>
 
+#include <glm/geometric.hpp>
 #include "io/obj_piece.hpp"
 #include "io/text_lines.hpp"
+
 #include "softrast/image.hpp"
 
 namespace softrast::detail {
@@ -49,24 +53,29 @@ bool mtl_number_out_of_range(std::string_view word) {
   return digits > 9;
 }
 
-// For each material that tinyobj::LoadMtl will produce from `text`, in its order, whether the
-// MTL gave it a Kd. Mirrors LoadMtl: one material per `newmtl` line (names are never empty
-// after its trimming), or a single unnamed one if there is no `newmtl` at all.
-std::vector<bool> scan_kd(const std::string& text) {
-  std::vector<bool> has_kd;
-  bool unnamed_kd = false;
+// For each material that tinyobj::LoadMtl will produce from `text`, in its order, which of Kd,
+// Ks and Ns the MTL gave it (tinyobj cannot tell a missing one from its zero default). Mirrors
+// LoadMtl: one material per `newmtl` line (names are never empty after its trimming), or a
+// single unnamed one if there is no `newmtl` at all.
+std::vector<MtlGiven> scan_given(const std::string& text) {
+  std::vector<MtlGiven> given;
+  MtlGiven unnamed;
   std::istringstream in(text);
   std::string line;
+  auto is_key = [](const char* token, const char* key) {
+    size_t n = std::strlen(key);
+    return std::strncmp(token, key, n) == 0 && (token[n] == ' ' || token[n] == '\t');
+  };
   while (std::getline(in, line, '\n')) {
     const char* token = line.c_str() + std::strspn(line.c_str(), " \t");
-    bool is_newmtl = std::strncmp(token, "newmtl", 6) == 0 && (token[6] == ' ' || token[6] == '\t');
-    bool is_kd = token[0] == 'K' && token[1] == 'd' && (token[2] == ' ' || token[2] == '\t');
-    if (is_newmtl) has_kd.push_back(false);
-    if (is_kd && has_kd.empty()) unnamed_kd = true;
-    if (is_kd && !has_kd.empty()) has_kd.back() = true;
+    if (is_key(token, "newmtl")) given.push_back({});
+    MtlGiven& g = given.empty() ? unnamed : given.back();
+    g.kd = g.kd || is_key(token, "Kd");
+    g.ks = g.ks || is_key(token, "Ks");
+    g.ns = g.ns || is_key(token, "Ns");
   }
-  if (has_kd.empty()) has_kd.push_back(unnamed_kd);
-  return has_kd;
+  if (given.empty()) given.push_back(unnamed);
+  return given;
 }
 
 }  // namespace
@@ -107,22 +116,67 @@ Status ObjMaterials::load_library(const std::string& name, const std::string& ob
   std::istringstream in(text);
   std::string warn;
   tinyobj::LoadMtl(&ids_, &all_, &in, &warn, nullptr);
-  std::vector<bool> kd = scan_kd(text);
-  // Should the scan ever disagree with tinyobj, trust tinyobj's Kd values.
-  kd.resize(all_.size() - first, true);
-  has_kd_.insert(has_kd_.end(), kd.begin(), kd.end());
+  std::vector<MtlGiven> given = scan_given(text);
+  // Should the scan ever disagree with tinyobj, trust tinyobj's values.
+  given.resize(all_.size() - first, MtlGiven{true, true, true});
+  given_.insert(given_.end(), given.begin(), given.end());
   dirs_.resize(all_.size(), path.parent_path());
   return {};
 }
 
 namespace {
 
-// Returns the texture at `file`, loading it on first use so that materials share it.
-using TextureCache = std::map<std::string, std::shared_ptr<const Texture>>;
+// What a map holds: colour (sRGB, as images are stored), other data (linear), or a normal map
+// that may come as a greyscale height map (bump).
+enum class MapKind { kColor, kData, kBump };
 
-Result<std::shared_ptr<const Texture>> texture_at(const fs::path& file, TextureCache& cache) {
+struct LoadedMap {
+  std::shared_ptr<const Texture> texture;
+  bool from_height = false;  // a greyscale bump map turned into a normal map
+};
+using TextureCache = std::map<std::string, LoadedMap>;
+
+// Whether every pixel of `image` is grey (r = g = b): a bump map then holds heights.
+bool is_greyscale(const Image& image) {
+  for (size_t k = 0; k + 3 < image.rgba.size(); k += 4) {
+    if (image.rgba[k] != image.rgba[k + 1] || image.rgba[k] != image.rgba[k + 2]) return false;
+  }
+  return true;
+}
+
+// Tangent-space normals of a height map (red / 255), by central differences with wrap-around:
+// n = normalize(-kSlope * scale * dh/du, -kSlope * scale * dh/dv, 1) per texel, dh in full
+// range per texel. kSlope = 8: a rise of 1/8 of the range over one texel tilts by 45 degrees,
+// so the gentle gradients of a typical 8-bit bump map show without a -bm.
+Image height_to_normals(const Image& height, float scale) {
+  constexpr float kSlope = 8.0f;
+  Image out = height;
+  const int w = height.width, h = height.height;
+  auto at = [&](int x, int y) {
+    x = (x % w + w) % w, y = (y % h + h) % h;
+    return float(height.pixel(x, y)[0]) / 255.0f;
+  };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      // Rows run top-down in an image and v up: dh/dv is the row above minus the row below.
+      float du = 0.5f * (at(x + 1, y) - at(x - 1, y)) * kSlope * scale;
+      float dv = 0.5f * (at(x, y - 1) - at(x, y + 1)) * kSlope * scale;
+      glm::vec3 n = glm::normalize(glm::vec3(-du, -dv, 1.0f));
+      uint8_t* p = &out.rgba[(size_t(y) * size_t(w) + size_t(x)) * 4];
+      for (int c = 0; c < 3; ++c) p[c] = uint8_t((n[c] * 0.5f + 0.5f) * 255.0f + 0.5f);
+      p[3] = 255;
+    }
+  }
+  return out;
+}
+
+// Returns the map at `file`, loading it on first use so that materials share it.
+Result<LoadedMap> texture_at(const fs::path& file, TextureCache& cache, MapKind kind,
+                             float bump_scale = 1.0f) {
   std::string key = file.lexically_normal().string();
-  if (auto it = cache.find(key); it != cache.end()) return it->second;
+  std::string cache_key = key + "\n" + std::to_string(int(kind));
+  if (kind == MapKind::kBump) cache_key.append(" ").append(std::to_string(bump_scale));
+  if (auto it = cache.find(cache_key); it != cache.end()) return it->second;
   std::error_code ec;
   if (fs::exists(file, ec) && !fs::is_regular_file(file, ec) && !fs::is_directory(file, ec)) {
     // A pipe or device that a material names: opening a FIFO would wait for a writer forever.
@@ -130,9 +184,35 @@ Result<std::shared_ptr<const Texture>> texture_at(const fs::path& file, TextureC
   }
   Result<Image> image = load_image(key);
   if (!image.ok()) return image.status();
-  auto texture = std::make_shared<const Texture>(Texture::from_image(*image));
-  cache.emplace(key, texture);
-  return std::shared_ptr<const Texture>(texture);
+  LoadedMap map;
+  ColorSpace space = kind == MapKind::kColor ? ColorSpace::kSrgb : ColorSpace::kLinear;
+  if (kind == MapKind::kBump && is_greyscale(*image)) {
+    map.from_height = true;
+    map.texture =
+        std::make_shared<const Texture>(Texture::from_image(height_to_normals(*image, bump_scale)));
+  } else {
+    map.texture = std::make_shared<const Texture>(Texture::from_image(*image, space));
+  }
+  cache.emplace(cache_key, map);
+  return map;
+}
+
+// Loads map `name` (relative to `dir`) of kind `kind` for `statement`; a map that cannot be
+// loaded is a warning and leaves the material without it.
+std::optional<LoadedMap> load_map(const fs::path& dir, const std::string& name, MapKind kind,
+                                  float bump_scale, TextureCache& cache, const std::string& where,
+                                  const std::string& statement,
+                                  std::vector<std::string>& warnings) {
+  if (name.empty()) return std::nullopt;
+  Result<LoadedMap> map = texture_at(dir / name, cache, kind, bump_scale);
+  if (map.ok()) return *map;
+  warnings.push_back(where + statement + ": " + map.status().message() +
+                     "; drawn without this texture");
+  return std::nullopt;
+}
+
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x + v.y + v.z);
 }
 
 }  // namespace
@@ -143,26 +223,82 @@ Result<std::vector<Material>> ObjMaterials::convert(const std::string& path,
   TextureCache cache;
   for (size_t i = 0; i < all_.size(); ++i) {
     const tinyobj::material_t& source = all_[i];
-    Material material;
-    material.name = source.name;
-    if (has_kd_[i]) {
-      material.diffuse = {source.diffuse[0], source.diffuse[1], source.diffuse[2]};
-      if (!std::isfinite(material.diffuse.x + material.diffuse.y + material.diffuse.z)) {
-        return fail(path, "Kd of material '" + source.name + "' is not finite");
-      }
+    Material m;
+    m.name = source.name;
+    const std::string named = "material '" + source.name + "'";
+    if (given_[i].kd) m.diffuse = {source.diffuse[0], source.diffuse[1], source.diffuse[2]};
+    if (given_[i].ks) m.specular = {source.specular[0], source.specular[1], source.specular[2]};
+    if (given_[i].ns) m.shininess = source.shininess;
+    m.opacity = source.dissolve;
+    if (!finite(m.diffuse)) return fail(path, "Kd of " + named + " is not finite");
+    if (!finite(m.specular)) return fail(path, "Ks of " + named + " is not finite");
+    if (!(m.shininess >= 0.0f && m.shininess <= 1000.0f)) {
+      return fail(path, "Ns of " + named + " is " + std::to_string(m.shininess) +
+                            "; it must be in [0, 1000]");
     }
-    if (!source.diffuse_texname.empty()) {
-      auto texture = texture_at(dirs_[i] / source.diffuse_texname, cache);
-      if (texture.ok()) {
-        material.diffuse_map = *texture;
-      } else {
-        warnings.push_back(path + ": material '" + source.name + "': map_Kd: " +
-                           texture.status().message() + "; drawn without this texture");
-      }
+    if (!(m.opacity >= 0.0f && m.opacity <= 1.0f)) {
+      return fail(path, "d (or Tr) of " + named + " is " + std::to_string(m.opacity) +
+                            "; it must be in [0, 1]");
     }
-    materials.push_back(std::move(material));
+    const fs::path& dir = dirs_[i];
+    const std::string where = path + ": " + named + ": ";
+    if (auto map = load_map(dir, source.diffuse_texname, MapKind::kColor, 1.0f, cache, where,
+                            "map_Kd", warnings)) {
+      m.diffuse_map = map->texture;
+    }
+    if (auto map = load_map(dir, source.specular_texname, MapKind::kData, 1.0f, cache, where,
+                            "map_Ks", warnings)) {
+      m.specular_map = map->texture;
+    }
+    if (auto map = load_map(dir, source.alpha_texname, MapKind::kData, 1.0f, cache, where, "map_d",
+                            warnings)) {
+      m.alpha_map = map->texture;
+    }
+    // norm is a normal map; map_Bump / bump is one too in most exporters' files, or a height
+    // map when it is grey. -bm scales either.
+    bool norm = !source.normal_texname.empty();
+    const std::string& bump_name = norm ? source.normal_texname : source.bump_texname;
+    float scale = norm ? source.normal_texopt.bump_multiplier : source.bump_texopt.bump_multiplier;
+    if (!std::isfinite(scale)) return fail(path, "-bm of " + named + " is not finite");
+    if (auto map = load_map(dir, bump_name, MapKind::kBump, scale, cache, where,
+                            norm ? "norm" : "map_Bump", warnings)) {
+      m.normal_map = map->texture;
+      m.normal_scale = map->from_height ? 1.0f : scale;
+    }
+    materials.push_back(std::move(m));
   }
   return materials;
+}
+
+std::optional<Material> tutorial_material(const std::string& obj_path,
+                                          std::vector<std::string>& warnings) {
+  fs::path obj(obj_path);
+  fs::path dir = obj.parent_path();
+  std::string stem = obj.stem().string();
+  auto beside = [&](const char* suffix) {
+    fs::path file = dir / (stem + suffix);
+    std::error_code ec;
+    return fs::is_regular_file(file, ec) ? file.filename().string() : std::string();
+  };
+  std::string diffuse = beside("_diffuse.tga"), spec = beside("_spec.tga");
+  std::string tangent = beside("_nm_tangent.tga"), object = beside("_nm.tga");
+  if (diffuse.empty() && spec.empty() && tangent.empty() && object.empty()) return std::nullopt;
+  Material m;
+  m.name = stem;
+  TextureCache cache;
+  const std::string where = obj_path + ": ";
+  if (auto map = load_map(dir, diffuse, MapKind::kColor, 1.0f, cache, where, diffuse, warnings)) {
+    m.diffuse_map = map->texture;
+  }
+  if (auto map = load_map(dir, spec, MapKind::kData, 1.0f, cache, where, spec, warnings)) {
+    m.specular_map = map->texture;
+  }
+  const std::string& normal = tangent.empty() ? object : tangent;
+  if (auto map = load_map(dir, normal, MapKind::kData, 1.0f, cache, where, normal, warnings)) {
+    m.normal_map = map->texture;
+    m.normal_space = tangent.empty() ? NormalSpace::kObject : NormalSpace::kTangent;
+  }
+  return m;
 }
 
 }  // namespace softrast::detail

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -14,6 +15,11 @@
 #include "softrast/mesh.hpp"
 
 namespace softrast::detail {
+
+// Which of the statements tinyobj cannot tell from their zero defaults a material had.
+struct MtlGiven {
+  bool kd = false, ks = false, ns = false;
+};
 
 // The materials of every MTL library the OBJ names, relative to the OBJ's folder, each with its
 // MTL's folder (texture paths are relative to it) and whether it had a Kd. A missing MTL is not an
@@ -34,7 +40,9 @@ class ObjMaterials {
     return it == ids_.end() ? -1 : it->second;
   }
 
-  // The materials with their textures; a map_Kd that cannot be loaded adds a warning instead.
+  // The materials with their maps (colour maps as sRGB textures, a grey bump map turned into a
+  // normal map); a map that cannot be loaded adds a warning instead. Errors: Kd or Ks not
+  // finite, Ns outside [0, 1000], d outside [0, 1].
   Result<std::vector<Material>> convert(const std::string& path,
                                         std::vector<std::string>& warnings) const;
 
@@ -47,8 +55,14 @@ class ObjMaterials {
   std::map<std::string, int> ids_;
   std::vector<tinyobj::material_t> all_;
   std::vector<std::filesystem::path> dirs_;
-  std::vector<bool> has_kd_;
+  std::vector<MtlGiven> given_;
   std::vector<std::string> warnings_;
 };
+
+// The material of the tutorial models' convention for the OBJ at `obj_path` (see load_obj):
+// its <model>_diffuse.tga, _spec.tga, _nm_tangent.tga or _nm.tga beside it, or nullopt when there
+// is none. A map that exists but cannot be loaded adds a warning.
+std::optional<Material> tutorial_material(const std::string& obj_path,
+                                          std::vector<std::string>& warnings);
 
 }  // namespace softrast::detail

@@ -424,7 +424,18 @@ Result<Mesh> ObjMerge::finish() {
   if (!materials.ok()) return materials.status();
   Mesh mesh = build_mesh();
   mesh.materials = std::move(*materials);
+  if (mesh.materials.empty()) {
+    // No MTL materials: the tutorial models' maps beside the file, drawn on every face.
+    if (std::optional<Material> m = detail::tutorial_material(path_, warnings)) {
+      mesh.materials.push_back(std::move(*m));
+      for (SubMesh& run : mesh.submeshes) run.material = 0;
+    }
+  }
   mesh.warnings = std::move(warnings);
+  bool tangent_maps = std::any_of(mesh.materials.begin(), mesh.materials.end(), [](const auto& m) {
+    return m.normal_map && m.normal_space == NormalSpace::kTangent;
+  });
+  if (tangent_maps) compute_tangents(mesh);
   return mesh;
 }
 

@@ -25,7 +25,8 @@ Texture make_texture(int size, const std::function<glm::vec3(float, float)>& f) 
       p[0] = to_unorm8(c.r), p[1] = to_unorm8(c.g), p[2] = to_unorm8(c.b), p[3] = 255;
     }
   }
-  return Texture::from_image(image);
+  // Colour data: decoded from sRGB under --srgb, its mip chain built in linear space.
+  return Texture::from_image(image, ColorSpace::kSrgb);
 }
 
 // `diffuse` is the material's colour for the untextured shaders (flat, gouraud, wireframe).

@@ -10,6 +10,7 @@
 #include <glm/mat4x4.hpp>
 
 #include "shaders/shadow_map.hpp"
+#include "shaders/shading_math.hpp"
 #include "softrast/mesh.hpp"
 #include "softrast/shader.hpp"
 #include "softrast/texture.hpp"
@@ -33,6 +34,11 @@ struct Lighting {
   // single-sided surface seen from behind looks as it does from the front.
   bool two_sided = false;
   const ShadowMap* shadow = nullptr;  // phong: diffuse and specular times the light's visibility
+  // A point light at `position` (world space) instead of the direction `light`.
+  bool point = false;
+  glm::vec3 position{0.0f};
+  // Shaders encode their output with the sRGB transfer function (the linear workflow).
+  bool srgb_output = false;
 };
 
 // Inputs shared by the built-in shaders.
@@ -55,10 +61,12 @@ struct FlatShader {
   static constexpr int kVaryings = 0;
   MeshInputs in;
   glm::vec4 color;
+  bool srgb = false;  // encode the output (the linear workflow)
   glm::vec4 vertex(uint32_t i, float*) const { return in.clip(i); }
   template <int N>
   void shade(Fragments<N>& f) const {
     f.color = {color.r, color.g, color.b, color.a};
+    if (srgb) f.color = encode_srgb<N>(f.color);
   }
 };
 
@@ -89,6 +97,7 @@ struct GouraudShader {
   void shade(Fragments<N>& f) const {
     int first = kTwoSided && !f.front_facing ? 3 : 0;
     f.color = {f.varying(first), f.varying(first + 1), f.varying(first + 2), alpha};
+    if (lighting.srgb_output) f.color = encode_srgb<N>(f.color);
   }
 };
 
@@ -98,6 +107,7 @@ struct TextureShader {
   const Texture* texture;
   Sampler sampler;
   float alpha = 1.0f;
+  bool srgb = false;  // encode the output (the linear workflow)
   glm::vec4 vertex(uint32_t i, float* v) const {
     v[0] = in.mesh->uvs[i].x, v[1] = in.mesh->uvs[i].y;
     return in.clip(i);
@@ -106,14 +116,33 @@ struct TextureShader {
   void shade(Fragments<N>& f) const {
     simd::Vec4<N> t = sample_with_derivatives(*texture, sampler, f, 0);
     f.color = {t.x, t.y, t.z, t.w * alpha};
+    if (srgb) f.color = encode_srgb<N>(f.color);
   }
 };
 
+// What phong reads of a material (renderer.cpp fills it from Material and RenderOptions).
+struct SurfaceMaps {
+  const Texture* diffuse = nullptr;     // albedo (and alpha) from here when set
+  const Texture* specular = nullptr;    // rgb multiplies specular_color
+  const Texture* normal = nullptr;      // the shading normal from here when set
+  bool object_space = false;            // the normal map's space (else tangent space)
+  float normal_scale = 1.0f;            // scales the map's x and y
+  const Texture* alpha = nullptr;       // red multiplies the alpha
+  glm::vec3 specular_color{kSpecular};  // Ks times the light intensity
+  float shininess = kShininess;
+  float opacity = 1.0f;
+};
+
+// Blinn-Phong per pixel with a material's maps: albedo from the diffuse map, specular colour
+// times the specular map, the normal from a normal map (object space, or tangent space with
+// the tangent frame interpolated: kTangents, 4 more varyings), one directional or point light.
+// Without maps and with SCENES.md's values it computes exactly what it always has.
+template <bool kTangents>
 struct PhongShader {
-  static constexpr int kVaryings = 8;  // world position, normal, uv
+  static constexpr int kVaryings = kTangents ? 12 : 8;  // world position, normal, uv (tangent)
   MeshInputs in;
   glm::vec3 albedo;
-  const Texture* texture = nullptr;  // albedo from here when set
+  SurfaceMaps maps;
   Sampler sampler;
   Lighting lighting;
   glm::vec3 eye;
@@ -124,33 +153,55 @@ struct PhongShader {
     const glm::vec2& uv = in.mesh->uvs[i];
     v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = n.x, v[4] = n.y, v[5] = n.z, v[6] = uv.x,
     v[7] = uv.y;
+    if constexpr (kTangents) {
+      const glm::vec4& t = in.mesh->tangents[i];
+      v[8] = t.x, v[9] = t.y, v[10] = t.z, v[11] = t.w;
+    }
     return in.clip(i);
+  }
+  // The unit shading normal: the interpolated one, or the normal map's; flipped on back faces
+  // when lighting is two-sided.
+  template <int N>
+  SOFTRAST_SIMD_INLINE simd::Vec3<N> normal(const Fragments<N>& f) const {
+    using F = simd::Float<N>;
+    simd::Vec3<N> n = simd::normalize(f.vec3(3));
+    if (maps.normal) {
+      simd::Vec3<N> m =
+          map_normal<N>(sample_with_derivatives(*maps.normal, sampler, f, 6), maps.normal_scale);
+      if (maps.object_space) {
+        n = simd::normalize(m);
+      } else if constexpr (kTangents) {
+        n = tangent_to_world<N>(m, n, f.vec3(8), f.varying(11));
+      }
+    }
+    if (lighting.two_sided && !f.front_facing) n = n * F(-1.0f);
+    return n;
   }
   template <int N>
   void shade(Fragments<N>& f) const {
     using F = simd::Float<N>;
-    simd::Vec3<N> n = simd::normalize(f.vec3(3));
-    if (lighting.two_sided && !f.front_facing) n = n * F(-1.0f);
-    simd::Vec3<N> view = simd::normalize(simd::splat3<N>(eye) - f.vec3(0));
-    simd::Vec3<N> l = simd::splat3<N>(lighting.light);
-    simd::Vec3<N> h = simd::normalize(l + view);
-    F d = simd::max(simd::dot(n, l), F(0.0f));
-    F s = simd::select(d > F(0.0f), pow_shininess(simd::max(simd::dot(n, h), F(0.0f))), F(0.0f));
+    simd::Vec3<N> n = normal(f);
+    simd::Vec3<N> p = f.vec3(0);
+    simd::Vec3<N> view = simd::normalize(simd::splat3<N>(eye) - p);
+    simd::Vec3<N> l = lighting.point ? simd::normalize(simd::splat3<N>(lighting.position) - p)
+                                     : simd::splat3<N>(lighting.light);
+    LightTerms<N> light = blinn_phong<N>(n, l, view, maps.shininess);
     simd::Vec4<N> base{F(albedo.r), F(albedo.g), F(albedo.b), F(1.0f)};
-    if (texture) base = sample_with_derivatives(*texture, sampler, f, 6);
-    F visible = lighting.shadow ? shadow_visibility<N>(*lighting.shadow, f.vec3(0), simd::dot(n, l))
-                                : F(1.0f);
-    F lit = F(lighting.ambient) + F(lighting.diffuse) * d * visible;
-    F spec = F(lighting.specular) * s * visible;
-    f.color = {base.x * lit + spec, base.y * lit + spec, base.z * lit + spec, base.w * alpha};
-  }
-  // x^32 by five squarings (kShininess is 32).
-  template <int N>
-  static simd::Float<N> pow_shininess(const simd::Float<N>& base) {
-    static_assert(kShininess == 32.0f);
-    simd::Float<N> x = base;
-    for (int k = 0; k < 5; ++k) x = x * x;
-    return x;
+    if (maps.diffuse) base = sample_with_derivatives(*maps.diffuse, sampler, f, 6);
+    simd::Vec3<N> ks = simd::splat3<N>(maps.specular_color);
+    if (maps.specular) {
+      simd::Vec4<N> k = sample_with_derivatives(*maps.specular, sampler, f, 6);
+      ks = ks * simd::Vec3<N>{k.x, k.y, k.z};
+    }
+    F a = base.w * F(alpha * maps.opacity);
+    if (maps.alpha) a = a * sample_with_derivatives(*maps.alpha, sampler, f, 6).x;
+    F visible =
+        lighting.shadow ? shadow_visibility<N>(*lighting.shadow, p, simd::dot(n, l)) : F(1.0f);
+    F lit = F(lighting.ambient) + F(lighting.diffuse) * light.diffuse * visible;
+    F spec = light.specular * visible;
+    f.color = {base.x * lit + ks.x * spec, base.y * lit + ks.y * spec, base.z * lit + ks.z * spec,
+               a};
+    if (lighting.srgb_output) f.color = encode_srgb<N>(f.color);
   }
 };
 

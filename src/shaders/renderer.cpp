@@ -26,17 +26,65 @@ constexpr std::array<std::pair<ShaderKind, const char*>, 7> kShaderNames = {{
 // What one submesh is drawn with.
 struct Surface {
   glm::vec3 albedo;
-  const Texture* texture;  // null: untextured
+  const Texture* texture;      // null: untextured
+  detail::SurfaceMaps maps{};  // phong's material (maps.diffuse is `texture`)
 };
+
+using Maps = RenderOptions::Maps;
 
 Surface surface_of(const Mesh& mesh, int material, const RenderOptions& opt) {
   Surface s{opt.color, opt.texture.get()};
+  s.maps.specular_color = glm::vec3(detail::kSpecular * opt.light_intensity);
   if (material >= 0 && material < int(mesh.materials.size())) {
     const Material& m = mesh.materials[size_t(material)];
     s.albedo = m.diffuse;
-    if (!s.texture) s.texture = m.diffuse_map.get();
+    if (!s.texture && opt.maps != Maps::kNone) s.texture = m.diffuse_map.get();
+    s.maps.specular_color = m.specular * opt.light_intensity;
+    s.maps.shininess = m.shininess;
+    s.maps.opacity = m.opacity;
+    if (opt.maps == Maps::kAll) {
+      s.maps.specular = m.specular_map.get();
+      s.maps.normal = m.normal_map.get();
+      s.maps.object_space = m.normal_space == NormalSpace::kObject;
+      s.maps.normal_scale = m.normal_scale;
+      s.maps.alpha = m.alpha_map.get();
+    }
   }
+  s.maps.diffuse = s.texture;
   return s;
+}
+
+// Whether a texture has texels that are not opaque, judged from its smallest level of at
+// least 64x64 texels (or the base level; a few thousand texels at most): a box-filtered level
+// keeps any translucent area of more than a few base texels below 250.
+bool has_translucent_texels(const Texture& t) {
+  int level = 0;
+  while (level + 1 < t.levels() && t.level(level + 1).width * t.level(level + 1).height >= 4096) {
+    ++level;
+  }
+  const MipLevel& l = t.level(level);
+  const uint8_t* texels = t.texels() + l.offset * 4;
+  for (size_t k = 0; k < size_t(l.width) * size_t(l.height); ++k) {
+    if (texels[k * 4 + 3] < 250) return true;
+  }
+  return false;
+}
+
+// Whether a surface lets what is behind it show (phong and texture): a material opacity below
+// 1 (MTL d), an alpha map, or a diffuse map with translucent texels (a cornea over an eye).
+bool translucent(const Surface& s, const RenderOptions& opt) {
+  if (opt.shader == ShaderKind::kTexture) return s.texture && has_translucent_texels(*s.texture);
+  if (opt.shader != ShaderKind::kPhong) return false;
+  return s.maps.opacity < 1.0f || s.maps.alpha ||
+         (s.maps.diffuse && has_translucent_texels(*s.maps.diffuse));
+}
+
+// Whether phong needs the mesh's tangents for `material`: a tangent-space normal map in use.
+bool needs_tangents(const Mesh& mesh, const RenderOptions& opt) {
+  if (opt.shader != ShaderKind::kPhong || opt.maps != Maps::kAll) return false;
+  return std::any_of(mesh.materials.begin(), mesh.materials.end(), [](const Material& m) {
+    return m.normal_map && m.normal_space == NormalSpace::kTangent;
+  });
 }
 
 // The view depths the depth view's grey ramp spans.
@@ -51,6 +99,9 @@ detail::Lighting lighting_of(const RenderOptions& opt) {
   l.diffuse = detail::kDiffuse * opt.light_intensity;
   l.specular = detail::kSpecular * opt.light_intensity;
   l.two_sided = opt.two_sided_lighting;
+  l.point = opt.light_position.has_value();
+  if (l.point) l.position = *opt.light_position;
+  l.srgb_output = opt.srgb;
   return l;
 }
 
@@ -67,9 +118,12 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
   // Two-sided Gouraud interpolates a second colour; only worth it when back faces are drawn.
   bool two_sided = lighting.two_sided && state.cull != CullMode::kBack;
   static const Texture kWhite;  // samples as opaque white
+  Sampler sampler = opt.sampler;
+  sampler.srgb_decode = opt.srgb;
   switch (kind) {
     case ShaderKind::kFlat:
-      return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, opt.alpha)}, indices, n);
+      return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, opt.alpha), opt.srgb}, indices,
+                  n);
     case ShaderKind::kWireframe:  // the overlay passes the wire colour as the surface albedo
       return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, 1.0f)}, indices, n);
     case ShaderKind::kGouraud:
@@ -81,13 +135,23 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
                   n);
     case ShaderKind::kTexture: {
       const Texture* t = surf.texture ? surf.texture : &kWhite;
-      return draw(fb, state, TextureShader{in, t, opt.sampler, opt.alpha}, indices, n);
+      return draw(fb, state, TextureShader{in, t, sampler, opt.alpha, opt.srgb}, indices, n);
     }
-    case ShaderKind::kPhong:
+    case ShaderKind::kPhong: {
+      SurfaceMaps maps = surf.maps;
+      bool tangents = maps.normal && !maps.object_space;
+      if (tangents && mesh.tangents.size() == mesh.positions.size()) {
+        return draw(
+            fb, state,
+            PhongShader<true>{in, surf.albedo, maps, sampler, lighting, camera.eye, opt.alpha},
+            indices, n);
+      }
+      if (tangents) maps.normal = nullptr;  // no tangent frame: the interpolated normal
       return draw(
           fb, state,
-          PhongShader{in, surf.albedo, surf.texture, opt.sampler, lighting, camera.eye, opt.alpha},
+          PhongShader<false>{in, surf.albedo, maps, sampler, lighting, camera.eye, opt.alpha},
           indices, n);
+    }
     case ShaderKind::kNormals:
       return draw(fb, state, NormalsShader{in}, indices, n);
     case ShaderKind::kDepth:
@@ -134,13 +198,17 @@ DepthRange visible_depth_range(int width, int height, const Mesh& mesh, const Ca
   return {view_depth(camera, lo), view_depth(camera, hi)};
 }
 
-// A mesh whose normals and uvs match its positions (the built-in shaders read all three).
-const Mesh& complete_mesh(const Mesh& mesh, Mesh& storage) {
+// A mesh whose normals and uvs match its positions (the built-in shaders read all three), and
+// its tangents when `tangents` (loaders compute them for their normal maps: this is the
+// fallback for meshes built otherwise).
+const Mesh& complete_mesh(const Mesh& mesh, Mesh& storage, bool tangents) {
   size_t n = mesh.positions.size();
-  if (mesh.normals.size() == n && mesh.uvs.size() == n) return mesh;
+  bool need_tangents = tangents && mesh.tangents.size() != n;
+  if (mesh.normals.size() == n && mesh.uvs.size() == n && !need_tangents) return mesh;
   storage = mesh;
   if (storage.normals.size() != n) compute_smooth_normals(storage);
   storage.uvs.resize(n, glm::vec2(0.0f));
+  if (need_tangents) compute_tangents(storage);
   return storage;
 }
 
@@ -166,7 +234,7 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
     return detail::render_debug_view(framebuffer, input, camera, options);
   }
   Mesh storage;
-  const Mesh& mesh = complete_mesh(input, storage);
+  const Mesh& mesh = complete_mesh(input, storage, needs_tangents(input, options));
   float aspect = float(framebuffer.width()) / float(framebuffer.height());
   glm::mat4 mvp = camera.view_projection(aspect);
   std::vector<SubMesh> runs = mesh.submeshes;
@@ -187,11 +255,20 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
     shadow = detail::build_shadow_map(mesh, options.light_direction, options.shadow_map_size,
                                       options.state.threads);
   }
-  for (const SubMesh& run : runs) {
-    std::span<const uint32_t> indices(mesh.indices.data() + run.first_index, run.index_count);
-    Surface surf = surface_of(mesh, run.material, options);
-    draw_run(framebuffer, state, mesh, camera, mvp, indices, surf, options, options.shader, depth,
-             shadow ? &*shadow : nullptr);
+  // Opaque runs first, then (when the state is opaque, as by default) the translucent ones
+  // blended over them without writing depth, in submission order.
+  RenderState blended = state;
+  blended.blend = BlendMode::kAlpha;
+  blended.depth_write = false;
+  for (bool second_pass : {false, true}) {
+    for (const SubMesh& run : runs) {
+      Surface surf = surface_of(mesh, run.material, options);
+      bool late = state.blend == BlendMode::kOpaque && translucent(surf, options);
+      if (late != second_pass) continue;
+      std::span<const uint32_t> indices(mesh.indices.data() + run.first_index, run.index_count);
+      draw_run(framebuffer, late ? blended : state, mesh, camera, mvp, indices, surf, options,
+               options.shader, depth);
+    }
   }
   if (options.wireframe_overlay && options.shader != ShaderKind::kWireframe) {
     RenderState wire = options.state;
@@ -206,7 +283,7 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
     wire.polygon_offset_factor = -1.0f;
     wire.polygon_offset_units = -4.0f;
     std::span<const uint32_t> all(mesh.indices);
-    draw_run(framebuffer, wire, mesh, camera, mvp, all, Surface{options.wire_color, nullptr},
+    draw_run(framebuffer, wire, mesh, camera, mvp, all, Surface{options.wire_color, nullptr, {}},
              options, ShaderKind::kWireframe, depth);
   }
 }

@@ -2,6 +2,8 @@
 // flip from file order (top row first) to texel order (bottom first), and the mip chain.
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
@@ -9,7 +11,26 @@
 
 namespace softrast {
 
-Texture Texture::from_image(const Image& image) {
+float srgb_to_linear(float c) {
+  return c <= 0.04045f ? c / 12.92f : float(std::pow((double(c) + 0.055) / 1.055, 2.4));
+}
+
+float linear_to_srgb(float c) {
+  if (!(c > 0.0f)) return 0.0f;
+  if (c >= 1.0f) return 1.0f;
+  return c <= 0.0031308f ? c * 12.92f : float(1.055 * std::pow(double(c), 1.0 / 2.4) - 0.055);
+}
+
+const float* srgb_decode_table() {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int k = 0; k < 256; ++k) t[size_t(k)] = srgb_to_linear(float(k) / 255.0f);
+    return t;
+  }();
+  return table.data();
+}
+
+Texture Texture::from_image(const Image& image, ColorSpace space) {
   size_t row_bytes = size_t(image.width) * 4;
   if (image.width < 0 || image.height < 0 ||
       image.rgba.size() != row_bytes * size_t(image.height)) {
@@ -20,6 +41,7 @@ Texture Texture::from_image(const Image& image) {
   }
   if (image.rgba.empty()) return Texture();  // a 0 x n image: samples as opaque white
   Texture texture;
+  texture.space_ = space;
   texture.width_ = image.width;
   texture.height_ = image.height;
   texture.levels_ = mip_levels(image.width, image.height);
@@ -30,7 +52,36 @@ Texture Texture::from_image(const Image& image) {
     std::copy(source, source + row_bytes, texture.texels_.begin() + row_bytes * size_t(j));
   }
   for (size_t k = 1; k < texture.levels_.size(); ++k) {
-    texture.downsample(texture.levels_[k - 1], texture.levels_[k]);
+    if (space == ColorSpace::kSrgb) {
+      texture.downsample_srgb(texture.levels_[k - 1], texture.levels_[k]);
+    } else {
+      texture.downsample(texture.levels_[k - 1], texture.levels_[k]);
+    }
+  }
+  return texture;
+}
+
+Texture Texture::from_mip_levels(const std::vector<Image>& levels, ColorSpace space) {
+  if (levels.empty()) return Texture();
+  Texture texture = from_image(levels[0], space);
+  bool sizes_match = texture.levels_.size() == levels.size();
+  for (size_t k = 0; sizes_match && k < levels.size(); ++k) {
+    sizes_match = levels[k].width == texture.levels_[k].width &&
+                  levels[k].height == texture.levels_[k].height &&
+                  levels[k].rgba.size() == size_t(levels[k].width) * levels[k].height * 4;
+  }
+  if (!sizes_match) {
+    std::fprintf(stderr, "Texture::from_mip_levels: %zu levels do not make the chain of %dx%d\n",
+                 levels.size(), levels[0].width, levels[0].height);
+    std::abort();
+  }
+  for (size_t k = 1; k < levels.size(); ++k) {
+    const MipLevel& l = texture.levels_[k];
+    size_t row_bytes = size_t(l.width) * 4;
+    for (int j = 0; j < l.height; ++j) {
+      const uint8_t* source = levels[k].pixel(0, l.height - 1 - j);
+      std::copy(source, source + row_bytes, texture.texels_.begin() + l.offset * 4 + row_bytes * j);
+    }
   }
   return texture;
 }
@@ -59,6 +110,29 @@ void Texture::downsample(const MipLevel& from, const MipLevel& to) {
       const uint8_t* d = &texels_[(from.offset + size_t(j1) * from.width + i1) * 4];
       uint8_t* out = &texels_[(to.offset + size_t(j) * to.width + i) * 4];
       for (int ch = 0; ch < 4; ++ch) out[ch] = uint8_t((a[ch] + b[ch] + c[ch] + d[ch] + 2) / 4);
+    }
+  }
+}
+
+// The box filter of downsample on linear values: RGB decoded from sRGB, averaged, encoded again
+// (rounded to nearest); alpha as in downsample. Averaging the bytes themselves would darken
+// minified colour textures (the mean of 0 and 255 is 128, which decodes to 0.22, not 0.5).
+void Texture::downsample_srgb(const MipLevel& from, const MipLevel& to) {
+  const float* decode = srgb_decode_table();
+  for (int j = 0; j < to.height; ++j) {
+    int j0 = std::min(2 * j, from.height - 1), j1 = std::min(2 * j + 1, from.height - 1);
+    for (int i = 0; i < to.width; ++i) {
+      int i0 = std::min(2 * i, from.width - 1), i1 = std::min(2 * i + 1, from.width - 1);
+      const uint8_t* a = &texels_[(from.offset + size_t(j0) * from.width + i0) * 4];
+      const uint8_t* b = &texels_[(from.offset + size_t(j0) * from.width + i1) * 4];
+      const uint8_t* c = &texels_[(from.offset + size_t(j1) * from.width + i0) * 4];
+      const uint8_t* d = &texels_[(from.offset + size_t(j1) * from.width + i1) * 4];
+      uint8_t* out = &texels_[(to.offset + size_t(j) * to.width + i) * 4];
+      for (int ch = 0; ch < 3; ++ch) {
+        float mean = 0.25f * (decode[a[ch]] + decode[b[ch]] + decode[c[ch]] + decode[d[ch]]);
+        out[ch] = uint8_t(linear_to_srgb(mean) * 255.0f + 0.5f);
+      }
+      out[3] = uint8_t((a[3] + b[3] + c[3] + d[3] + 2) / 4);
     }
   }
 }

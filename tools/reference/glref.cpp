@@ -67,6 +67,7 @@ struct Failure {
 
 struct Options {
   std::string model;
+  bool trilinear = false;  // --filter trilinear: a mip chain and GL_LINEAR_MIPMAP_LINEAR
   int width = 800, height = 600;
   std::optional<glm::vec3> eye, target;
   glm::vec3 up{0.0f, 1.0f, 0.0f};
@@ -97,6 +98,8 @@ constexpr const char* kHelp =
     "  --ortho L,R,B,T     glOrtho box instead of a perspective\n"
     "  --shader NAME       flat, gouraud, texture, phong, normals or wireframe (phong)\n"
     "  --texture PATH      PNG/TGA texture for texture and phong\n"
+    "  --filter MODE       bilinear or trilinear (GL_LINEAR_MIPMAP_LINEAR, glGenerateMipmap)\n"
+    "                      (bilinear)\n"
     "  --color R,G,B       albedo for flat, gouraud and phong (0.9,0.6,0.3)\n"
     "  --alpha A           output alpha (1)\n"
     "  --cull MODE         back, front or none (none; back faces lit as front faces, as\n"
@@ -194,6 +197,9 @@ bool apply_flag(const std::string& flag, const std::string& value, Options& o) {
     o.shader = value;
   } else if (flag == "--texture") {
     o.texture = value;
+  } else if (flag == "--filter") {
+    check_choice(flag, value, {"bilinear", "trilinear"});
+    o.trilinear = value == "trilinear";
   } else if (flag == "--color") {
     o.color = parse_vec3(flag, value);
   } else if (flag == "--alpha") {
@@ -605,7 +611,7 @@ void upload_mesh(const Mesh& mesh) {
 // The texture as SCENES.md wants it: RGBA8 (no sRGB), flipped so that v = 0 is the last row of
 // the file, GL_LINEAR for both filters without mipmaps, GL_REPEAT. Without --texture, one
 // opaque white texel (softrast samples a missing texture as white).
-void upload_texture(const std::optional<std::string>& path) {
+void upload_texture(const std::optional<std::string>& path, bool trilinear) {
   int w = 1, h = 1;
   std::vector<uint8_t> texels = {255, 255, 255, 255};
   if (path) {
@@ -622,12 +628,15 @@ void upload_texture(const std::optional<std::string>& path) {
   glBindTexture(GL_TEXTURE_2D, texture);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
   glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, texels.data());
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER,
+                  trilinear ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, trilinear ? 1000 : 0);
+  // The chain built once, by the driver's box filter (softrast builds it at load as well).
+  if (trilinear) glGenerateMipmap(GL_TEXTURE_2D);
   check_gl("upload_texture");
 }
 
@@ -844,7 +853,7 @@ int run(int argc, char** argv) {
   log(std::string("renderer ") + context.renderer() + ", " + std::to_string(mesh.triangles()) +
       " triangles, " + std::to_string(mesh.vertices.size()) + " vertices");
   upload_mesh(mesh);
-  upload_texture(o.texture);
+  upload_texture(o.texture, o.trilinear);
   set_uniforms(make_program(o.shader), o);
   set_state(o);
   make_multisample_target(o);

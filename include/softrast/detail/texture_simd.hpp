@@ -46,12 +46,20 @@ SOFTRAST_SIMD_INLINE simd::Int<N> wrap_texel(Wrap mode, const simd::Int<N>& i,
   return r;
 }
 
-// RGBA8 texels to channels in [0, 1].
+// RGBA8 texels to channels in [0, 1]; `decode`: RGB through the sRGB decode table
+// (Texture::decodes).
 template <int N>
-SOFTRAST_SIMD_INLINE simd::Vec4<N> unpack_texel(const simd::Int<N>& texel) {
+SOFTRAST_SIMD_INLINE simd::Vec4<N> unpack_texel(const simd::Int<N>& texel, bool decode) {
   using F = simd::Float<N>;
   const F k(1.0f / 255.0f);
   simd::Int<N> byte(0xff);
+  if (decode) {
+    const int32_t* table = reinterpret_cast<const int32_t*>(srgb_decode_table());
+    return {simd::bit_cast_float(simd::gather<N>(table, texel & byte)),
+            simd::bit_cast_float(simd::gather<N>(table, (texel >> 8) & byte)),
+            simd::bit_cast_float(simd::gather<N>(table, (texel >> 16) & byte)),
+            simd::to_float(texel >> 24) * k};
+  }
   return {simd::to_float(texel & byte) * k, simd::to_float((texel >> 8) & byte) * k,
           simd::to_float((texel >> 16) & byte) * k, simd::to_float(texel >> 24) * k};
 }
@@ -60,9 +68,9 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> unpack_texel(const simd::Int<N>& texel) {
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> fetch(const Texture& t, const simd::Int<N>& i,
                                          const simd::Int<N>& j, const simd::Int<N>& w,
-                                         const simd::Int<N>& offset) {
+                                         const simd::Int<N>& offset, bool decode) {
   return unpack_texel<N>(
-      simd::gather<N>(reinterpret_cast<const int32_t*>(t.texels()), offset + j * w + i));
+      simd::gather<N>(reinterpret_cast<const int32_t*>(t.texels()), offset + j * w + i), decode);
 }
 
 template <int N>
@@ -83,10 +91,11 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_level(const Texture& t, const Sampler&
   using I = simd::Int<N>;
   F fx, fy;
   F wf = simd::to_float(w), hf = simd::to_float(h);
+  const bool d = t.decodes(s);
   if (nearest) {
     I i = wrap_texel<N>(s.wrap_u, texel_floor<N>(uv.x * wf, fx), w, pow2_u);
     I j = wrap_texel<N>(s.wrap_v, texel_floor<N>(uv.y * hf, fy), h, pow2_v);
-    return fetch<N>(t, i, j, w, offset);
+    return fetch<N>(t, i, j, w, offset, d);
   }
   // Texel centres sit at half-integers: shift by half a texel, then split (GL_LINEAR).
   I x0 = texel_floor<N>(uv.x * wf - F(0.5f), fx);
@@ -103,13 +112,14 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_level(const Texture& t, const Sampler&
     I b0, b1, t0, t1;
     simd::gather_pair<N>(texels, offset + j0 * w + i0, b0, b1);
     simd::gather_pair<N>(texels, offset + j1 * w + i0, t0, t1);
-    simd::Vec4<N> bottom = lerp<N>(unpack_texel<N>(b0), unpack_texel<N>(b1), fx);
-    simd::Vec4<N> top = lerp<N>(unpack_texel<N>(t0), unpack_texel<N>(t1), fx);
+    simd::Vec4<N> bottom = lerp<N>(unpack_texel<N>(b0, d), unpack_texel<N>(b1, d), fx);
+    simd::Vec4<N> top = lerp<N>(unpack_texel<N>(t0, d), unpack_texel<N>(t1, d), fx);
     return lerp<N>(bottom, top, fy);
   }
   simd::Vec4<N> bottom =
-      lerp<N>(fetch<N>(t, i0, j0, w, offset), fetch<N>(t, i1, j0, w, offset), fx);
-  simd::Vec4<N> top = lerp<N>(fetch<N>(t, i0, j1, w, offset), fetch<N>(t, i1, j1, w, offset), fx);
+      lerp<N>(fetch<N>(t, i0, j0, w, offset, d), fetch<N>(t, i1, j0, w, offset, d), fx);
+  simd::Vec4<N> top =
+      lerp<N>(fetch<N>(t, i0, j1, w, offset, d), fetch<N>(t, i1, j1, w, offset, d), fx);
   return lerp<N>(bottom, top, fy);
 }
 
