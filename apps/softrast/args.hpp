@@ -19,12 +19,13 @@ struct RawArgs {
   std::string up_axis = "+y";
   std::optional<std::string> view;
   std::optional<float> azimuth, elevation, zoom;
-  std::string shader = "phong";
+  std::string shader;  // empty: phong, or pbr for glTF models (JobSpec::auto_shader)
   bool wireframe = false;
   std::optional<std::string> texture;
   std::optional<std::string> color;
   std::optional<std::string> light;
   std::optional<float> ambient, light_intensity;
+  std::optional<float> exposure;
   std::optional<std::string> edge_color;
   std::optional<std::string> background;
   std::string cull = "none";

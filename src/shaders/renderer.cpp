@@ -8,12 +8,13 @@
 
 #include "debug/debug_render.hpp"
 #include "shaders/builtin_shaders.hpp"
+#include "shaders/pbr_render.hpp"
 #include "softrast/renderer.hpp"
 
 namespace softrast {
 namespace {
 
-constexpr std::array<std::pair<ShaderKind, const char*>, 7> kShaderNames = {{
+constexpr std::array<std::pair<ShaderKind, const char*>, 8> kShaderNames = {{
     {ShaderKind::kFlat, "flat"},
     {ShaderKind::kGouraud, "gouraud"},
     {ShaderKind::kTexture, "texture"},
@@ -21,6 +22,7 @@ constexpr std::array<std::pair<ShaderKind, const char*>, 7> kShaderNames = {{
     {ShaderKind::kNormals, "normals"},
     {ShaderKind::kDepth, "depth"},
     {ShaderKind::kWireframe, "wireframe"},
+    {ShaderKind::kPbr, "pbr"},
 }};
 
 // What one submesh is drawn with.
@@ -82,6 +84,7 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
       return draw(fb, state, TextureShader{in, t, opt.sampler, opt.alpha}, indices, n);
     }
     case ShaderKind::kPhong:
+    case ShaderKind::kPbr:  // drawn by render_pbr; phong if it ever gets here
       return draw(
           fb, state,
           PhongShader{in, surf.albedo, surf.texture, opt.sampler, lighting, camera.eye, opt.alpha},
@@ -180,10 +183,15 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
     depth = visible_depth_range(framebuffer.width(), framebuffer.height(), mesh, camera, mvp, runs,
                                 state);
   }
-  for (const SubMesh& run : runs) {
-    std::span<const uint32_t> indices(mesh.indices.data() + run.first_index, run.index_count);
-    Surface surf = surface_of(mesh, run.material, options);
-    draw_run(framebuffer, state, mesh, camera, mvp, indices, surf, options, options.shader, depth);
+  if (options.shader == ShaderKind::kPbr) {
+    detail::render_pbr(framebuffer, mesh, camera, mvp, runs, state, options);
+  } else {
+    for (const SubMesh& run : runs) {
+      std::span<const uint32_t> indices(mesh.indices.data() + run.first_index, run.index_count);
+      Surface surf = surface_of(mesh, run.material, options);
+      draw_run(framebuffer, state, mesh, camera, mvp, indices, surf, options, options.shader,
+               depth);
+    }
   }
   if (options.wireframe_overlay && options.shader != ShaderKind::kWireframe) {
     RenderState wire = options.state;
