@@ -69,7 +69,7 @@ TEST_F(GltfTest, GltfAndGlbOfOneSceneRenderIdentically) {
   EXPECT_EQ(text->triangle_count(), 12u);
   ASSERT_EQ(text->materials.size(), 1u);
   ASSERT_TRUE(text->materials[0].pbr.has_value());
-  ASSERT_TRUE(text->materials[0].pbr->base_color_map);  // the data-URI image was decoded
+  ASSERT_TRUE(text->materials[0].pbr->base_color_map);    // the data-URI image was decoded
   ASSERT_TRUE(binary->materials[0].pbr->base_color_map);  // and the bufferView one
   EXPECT_TRUE(text->warnings.empty()) << text->warnings[0];
   Image a = render(*text, 96), b = render(*binary, 96);
@@ -88,8 +88,8 @@ TEST_F(GltfTest, GltfAndGlbOfOneSceneRenderIdentically) {
   EXPECT_GT(white, 50);
 }
 
-// Node 0 translates by (0.25, 0, 0); its child node 1 turns by 30 degrees about y and scales by 0.8:
-// every loaded corner is T * R * S of a corner of the unit cube.
+// Node 0 translates by (0.25, 0, 0); its child node 1 turns by 30 degrees about y and scales by
+// 0.8: every loaded corner is T * R * S of a corner of the unit cube.
 TEST_F(GltfTest, NodeTransformsPlaceEveryVertex) {
   Result<Mesh> mesh = load_model(write("cube.gltf", test::as_gltf(test::textured_cube(png_))));
   ASSERT_TRUE(mesh.ok()) << mesh.status().message();
@@ -152,7 +152,8 @@ TEST_F(GltfTest, MirroringNodeKeepsFacesOutwardAndFlipsTangentHandedness) {
 // failure a diff image (red where out of tolerance) is written and its path printed. Re-create
 // with SOFTRAST_UPDATE_GOLDEN=1, then look at the image before committing it.
 TEST_F(GltfTest, SphereGridMatchesGolden) {
-  Result<Mesh> mesh = load_model(write("spheres.glb", test::as_glb(test::sphere_grid(5, 5, 1.0f, 0.78f, 0.34f))));
+  Result<Mesh> mesh =
+      load_model(write("spheres.glb", test::as_glb(test::sphere_grid(5, 5, 1.0f, 0.78f, 0.34f))));
   ASSERT_TRUE(mesh.ok()) << mesh.status().message();
   Camera camera;
   camera.eye = {0.0f, 0.0f, 9.0f};
@@ -199,7 +200,8 @@ TEST_F(GltfTest, SphereGridMatchesGolden) {
 // is lit (not black), and the smooth full metal one reflects the sky above and the ground below
 // (its top is brighter than its bottom).
 TEST_F(GltfTest, SphereGridLooksPhysical) {
-  Result<Mesh> mesh = load_model(write("spheres.gltf", test::as_gltf(test::sphere_grid(2, 2, 0.9f, 0.9f, 0.9f))));
+  Result<Mesh> mesh =
+      load_model(write("spheres.gltf", test::as_gltf(test::sphere_grid(2, 2, 0.9f, 0.9f, 0.9f))));
   ASSERT_TRUE(mesh.ok()) << mesh.status().message();
   Camera camera;
   camera.eye = {0.0f, 0.0f, 6.0f};
@@ -326,7 +328,8 @@ TEST_F(GltfTest, CliRendersGltfAndGlbWithNoFlags) {
   folder.write("cube.gltf", test::as_gltf(cube));
   folder.write("cube.glb", test::as_glb(cube));
   for (const char* name : {"cube.gltf", "cube.glb"}) {
-    test::CliResult r = folder.run(std::string("render ") + name + " --size 64x64 -o out.png --json");
+    test::CliResult r =
+        folder.run(std::string("render ") + name + " --size 64x64 -o out.png --json");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("\"shader\":\"pbr\""), std::string::npos) << r.out;
     Result<Image> image = load_image(folder.path("out.png"));

@@ -54,8 +54,8 @@ inline int add_accessor(GltfParts& g, const std::string& bytes, int component_ty
   g.json["bufferViews"].push_back(
       {{"buffer", 0}, {"byteOffset", g.bin.size()}, {"byteLength", bytes.size()}});
   g.bin += bytes;
-  nlohmann::json a = {{"bufferView", view}, {"componentType", component_type}, {"count", count},
-                      {"type", type}};
+  nlohmann::json a = {
+      {"bufferView", view}, {"componentType", component_type}, {"count", count}, {"type", type}};
   if (!min.is_null()) a["min"] = min, a["max"] = max;
   int index = int(g.json["accessors"].size());
   g.json["accessors"].push_back(a);
@@ -98,8 +98,11 @@ inline std::string checker_png(const std::string& scratch_path) {
 inline GltfParts textured_cube(const std::string& png) {
   GltfParts g;
   g.png = png;
-  g.json = {{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}},
-            {"bufferViews", nlohmann::json::array()}, {"accessors", nlohmann::json::array()}};
+  g.json = {{"asset", {{"version", "2.0"}}},
+            {"scene", 0},
+            {"scenes", {{{"nodes", {0}}}}},
+            {"bufferViews", nlohmann::json::array()},
+            {"accessors", nlohmann::json::array()}};
   std::vector<float> p, n, uv;
   std::vector<uint16_t> idx;
   const float faces[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
@@ -117,8 +120,8 @@ inline GltfParts textured_cube(const std::string& png) {
       n.insert(n.end(), {nx, ny, nz});
       uv.insert(uv.end(), {0.5f + 0.5f * c[0], 0.5f - 0.5f * c[1]});  // glTF: v down
     }
-    idx.insert(idx.end(), {base, uint16_t(base + 1), uint16_t(base + 2), base,
-                           uint16_t(base + 2), uint16_t(base + 3)});
+    idx.insert(idx.end(), {base, uint16_t(base + 1), uint16_t(base + 2), base, uint16_t(base + 2),
+                           uint16_t(base + 3)});
   }
   int pos = add_accessor(g, float_bytes(p), 5126, 24, "VEC3", {-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5});
   int nrm = add_accessor(g, float_bytes(n), 5126, 24, "VEC3");
@@ -176,8 +179,11 @@ inline std::string as_glb(GltfParts g) {
 // the image: rows further down are more metallic) and roughness i / (columns - 1) (left to right).
 inline GltfParts sphere_grid(int columns, int rows, float r, float g_, float b) {
   GltfParts g;
-  g.json = {{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {}}}}},
-            {"bufferViews", nlohmann::json::array()}, {"accessors", nlohmann::json::array()}};
+  g.json = {{"asset", {{"version", "2.0"}}},
+            {"scene", 0},
+            {"scenes", {{{"nodes", {}}}}},
+            {"bufferViews", nlohmann::json::array()},
+            {"accessors", nlohmann::json::array()}};
   const int rings = 24, segments = 48;
   std::vector<float> p, n;
   std::vector<uint16_t> idx;
@@ -185,7 +191,8 @@ inline GltfParts sphere_grid(int columns, int rows, float r, float g_, float b) 
     float theta = 3.14159265f * float(i) / rings;
     for (int j = 0; j <= segments; ++j) {
       float phi = 2.0f * 3.14159265f * float(j) / segments;
-      float x = std::sin(theta) * std::cos(phi), y = std::cos(theta), z = -std::sin(theta) * std::sin(phi);
+      float x = std::sin(theta) * std::cos(phi), y = std::cos(theta),
+            z = -std::sin(theta) * std::sin(phi);
       p.insert(p.end(), {0.4f * x, 0.4f * y, 0.4f * z});
       n.insert(n.end(), {x, y, z});
     }
@@ -197,7 +204,8 @@ inline GltfParts sphere_grid(int columns, int rows, float r, float g_, float b) 
     }
   }
   int count = int(p.size() / 3);
-  int pos = add_accessor(g, float_bytes(p), 5126, count, "VEC3", {-0.4, -0.4, -0.4}, {0.4, 0.4, 0.4});
+  int pos =
+      add_accessor(g, float_bytes(p), 5126, count, "VEC3", {-0.4, -0.4, -0.4}, {0.4, 0.4, 0.4});
   int nrm = add_accessor(g, float_bytes(n), 5126, count, "VEC3");
   int ind = add_accessor(g, u16_bytes(idx), 5123, int(idx.size()), "SCALAR");
   g.json["meshes"] = nlohmann::json::array();
@@ -211,12 +219,13 @@ inline GltfParts sphere_grid(int columns, int rows, float r, float g_, float b) 
             {{"baseColorFactor", {r, g_, b, 1.0}},
              {"metallicFactor", rows > 1 ? double(j) / (rows - 1) : 0.0},
              {"roughnessFactor", columns > 1 ? double(i) / (columns - 1) : 0.5}}}});
-      g.json["meshes"].push_back(
-          {{"primitives",
-            {{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}}}, {"indices", ind}, {"material", m}}}}});
-      g.json["nodes"].push_back({{"mesh", m},
-                                 {"translation", {double(i) - 0.5 * (columns - 1),
-                                                  0.5 * (rows - 1) - double(j), 0.0}}});
+      g.json["meshes"].push_back({{"primitives",
+                                   {{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}}},
+                                     {"indices", ind},
+                                     {"material", m}}}}});
+      g.json["nodes"].push_back(
+          {{"mesh", m},
+           {"translation", {double(i) - 0.5 * (columns - 1), 0.5 * (rows - 1) - double(j), 0.0}}});
       g.json["scenes"][0]["nodes"].push_back(m);
     }
   }

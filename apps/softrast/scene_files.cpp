@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 // The extensions a folder's model files have (compared in lower case); each file is then read by
 // load_model(), which tells the formats apart by content.
 constexpr std::array<std::string_view, 5> kModelExtensions = {".obj", ".ply", ".stl", ".gltf",
-                                                             ".glb"};
+                                                              ".glb"};
 
 std::string lowercase(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(),

@@ -52,7 +52,8 @@ int main(int argc, char** argv) {
   blend.json["materials"][0]["alphaMode"] = "BLEND";
   blend.json["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {1, 1, 1, 0.5};
   std::vector<float> colors(24 * 4, 0.5f);
-  int c = softrast::test::add_accessor(blend, softrast::test::float_bytes(colors), 5126, 24, "VEC4");
+  int c =
+      softrast::test::add_accessor(blend, softrast::test::float_bytes(colors), 5126, 24, "VEC4");
   blend.json["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = c;
   blend.json["meshes"][0]["primitives"][0]["mode"] = 5;
   blend.json["nodes"][1] = {{"matrix", {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0.5, 0, 0, 1}},

@@ -28,9 +28,13 @@ constexpr std::array<std::string_view, 3> kSupportedExtensions = {
     "KHR_texture_transform", "KHR_materials_emissive_strength", "KHR_mesh_quantization"};
 
 // The data-URI media types TinyGLTF decodes (its IsDataURI); others it would take for file names.
-constexpr std::array<std::string_view, 7> kDataUriTypes = {
-    "application/octet-stream", "application/gltf-buffer", "text/plain", "image/png",
-    "image/jpeg",               "image/bmp",               "image/gif"};
+constexpr std::array<std::string_view, 7> kDataUriTypes = {"application/octet-stream",
+                                                           "application/gltf-buffer",
+                                                           "text/plain",
+                                                           "image/png",
+                                                           "image/jpeg",
+                                                           "image/bmp",
+                                                           "image/gif"};
 
 Status fail(const std::string& name, const std::string& reason) {
   return Status::error(name + ": " + reason);
@@ -141,7 +145,8 @@ Status check_data_uri(std::string_view uri, uint64_t byte_length, const std::str
   }
   std::string_view payload = uri.substr(comma + 1);
   uint64_t decoded = payload.size() / 4 * 3;
-  if (!payload.empty()) decoded -= (payload.back() == '=') + (payload.size() > 1 && payload[payload.size() - 2] == '=');
+  if (!payload.empty())
+    decoded -= (payload.back() == '=') + (payload.size() > 1 && payload[payload.size() - 2] == '=');
   if (byte_length != ~uint64_t(0) && decoded != byte_length) {
     return Status::error(what + ": the data URI holds " + std::to_string(decoded) +
                          " bytes, byteLength says " + std::to_string(byte_length));
@@ -159,7 +164,8 @@ Status check_buffer(const json& b, size_t index, const GlbChunks* glb, const std
   lengths.push_back(*length);
   auto uri_it = b.find("uri");
   if (uri_it == b.end()) {
-    if (!glb || index != 0) return Status::error(what + ": no uri (only a GLB's first buffer may omit it)");
+    if (!glb || index != 0)
+      return Status::error(what + ": no uri (only a GLB's first buffer may omit it)");
     if (!glb->has_bin) return Status::error(what + ": the GLB has no BIN chunk");
     if (*length > glb->bin_size) {
       return Status::error(what + ": byteLength " + std::to_string(*length) +
@@ -175,7 +181,8 @@ Status check_buffer(const json& b, size_t index, const GlbChunks* glb, const std
     return Status::error(what + ": byteLength " + std::to_string(*length) + " is over the limit (" +
                          std::to_string(kMaxGltfFileBytes >> 20) + " MiB)");
   }
-  if (base_dir.empty()) return Status::error(what + ": external file " + excerpt(uri) + " not allowed here");
+  if (base_dir.empty())
+    return Status::error(what + ": external file " + excerpt(uri) + " not allowed here");
   std::string file = url_decoded(uri);
   std::string path = (std::filesystem::path(base_dir) / file).string();
   struct stat info {};
@@ -295,8 +302,8 @@ bool write_file(std::string* err, const std::string&, const std::vector<unsigned
 
 // Images from data URIs are decoded here; those in bufferViews later (gltf_loader.cpp), once
 // the view's range has been checked; the pointer TinyGLTF passes for them is not read.
-bool load_image_data(tinygltf::Image* image, const int index, std::string*, std::string*, int,
-                     int, const unsigned char* bytes, int size, void* user) {
+bool load_image_data(tinygltf::Image* image, const int index, std::string*, std::string*, int, int,
+                     const unsigned char* bytes, int size, void* user) {
   auto* ctx = static_cast<Context*>(user);
   if (image->bufferView != -1 || index < 0 || size <= 0) return true;
   std::string what = ctx->name + ": image " + std::to_string(index);
@@ -344,9 +351,10 @@ Result<GltfDocument> read_gltf_document(const uint8_t* data, size_t size, const 
   loader.SetFsCallbacks({&file_exists, &expand_path, &read_file, &write_file, &ctx});
   loader.SetImageLoader(&load_image_data, &ctx);
   std::string err, warn;
-  bool ok = binary ? loader.LoadBinaryFromMemory(&doc.model, &err, &warn, data, glb.length, base_dir)
-                   : loader.LoadASCIIFromString(&doc.model, &err, &warn, text.data(),
-                                                unsigned(text.size()), base_dir);
+  bool ok = binary
+                ? loader.LoadBinaryFromMemory(&doc.model, &err, &warn, data, glb.length, base_dir)
+                : loader.LoadASCIIFromString(&doc.model, &err, &warn, text.data(),
+                                             unsigned(text.size()), base_dir);
   if (!ok) return fail(name, first_line(err));
   doc.images.resize(doc.model.images.size());
   return doc;

@@ -110,7 +110,8 @@ Result<AccessorBytes> locate(const tg::Model& m, int index, const std::vector<in
   uint64_t element = uint64_t(r.components) * uint64_t(bytes);
   r.stride = v.byteStride ? v.byteStride : size_t(element);
   if (r.stride < element) {
-    return fail(what, "byteStride " + n(r.stride) + " is less than its element (" + n(element) + ")");
+    return fail(what,
+                "byteStride " + n(r.stride) + " is less than its element (" + n(element) + ")");
   }
   if (r.count == 0) return r;
   // offset + (count - 1) * stride + element <= byteLength, without overflow.
@@ -168,7 +169,8 @@ Status read_floats(const tg::Model& m, int index, const std::vector<int>& types,
   out.assign(a->count, fill);
   for (size_t i = 0; i < a->count; ++i) {
     const uint8_t* p = a->first + i * a->stride;
-    for (int c = 0; c < std::min(a->components, width); ++c) out[i][c] = component(*a, p + c * bytes);
+    for (int c = 0; c < std::min(a->components, width); ++c)
+      out[i][c] = component(*a, p + c * bytes);
   }
   return {};
 }
@@ -207,7 +209,8 @@ Sampler sampler_of(const tg::Model& m, int index) {
   const tg::Sampler& t = m.samplers[size_t(index)];
   if (t.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) s.filter = Filter::kNearest;
   if (t.minFilter == TINYGLTF_TEXTURE_FILTER_LINEAR) s.filter = Filter::kBilinear;
-  if (t.minFilter == -1 && t.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) s.filter = Filter::kNearest;
+  if (t.minFilter == -1 && t.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST)
+    s.filter = Filter::kNearest;
   s.wrap_u = wrap_of(t.wrapS);
   s.wrap_v = wrap_of(t.wrapT);
   return s;
@@ -329,7 +332,8 @@ Material material_of(const tg::Material& g, TextureCache& cache) {
   p.metallic_roughness_map =
       cache.slot(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
                  pbr.metallicRoughnessTexture.extensions);
-  p.normal_map = cache.slot(g.normalTexture.index, g.normalTexture.texCoord, g.normalTexture.extensions);
+  p.normal_map =
+      cache.slot(g.normalTexture.index, g.normalTexture.texCoord, g.normalTexture.extensions);
   p.normal_scale = finite_or(g.normalTexture.scale, 1.0f);
   p.occlusion_map = cache.slot(g.occlusionTexture.index, g.occlusionTexture.texCoord,
                                g.occlusionTexture.extensions);
@@ -343,8 +347,8 @@ Material material_of(const tg::Material& g, TextureCache& cache) {
     strength = std::clamp(float(number(it->second, "emissiveStrength", 1.0)), 0.0f, 1.0e4f);
   }
   p.emissive = glm::clamp(glm::vec3(e), 0.0f, 1.0f) * strength;
-  p.emissive_map = cache.slot(g.emissiveTexture.index, g.emissiveTexture.texCoord,
-                              g.emissiveTexture.extensions);
+  p.emissive_map =
+      cache.slot(g.emissiveTexture.index, g.emissiveTexture.texCoord, g.emissiveTexture.extensions);
   p.alpha_mode = g.alphaMode == "MASK"    ? AlphaMode::kMask
                  : g.alphaMode == "BLEND" ? AlphaMode::kBlend
                                           : AlphaMode::kOpaque;
@@ -498,7 +502,8 @@ bool needs_tangents(const Mesh& mesh, int material) {
 }
 
 // Appends a piece transformed by `world` as a submesh of `material`.
-Status append(Builder& b, Piece& piece, const glm::mat4& world, int material, const std::string& what) {
+Status append(Builder& b, Piece& piece, const glm::mat4& world, int material,
+              const std::string& what) {
   if (piece.triangles.empty()) return {};
   size_t base = b.mesh.positions.size();
   // Checked before flat normals multiply the vertices (three per triangle) as well as after.
@@ -579,7 +584,8 @@ glm::mat4 local_transform(const tg::Node& node) {
     if (len > 0.0f && std::isfinite(len)) m = m * glm::mat4_cast(q / len);
   }
   if (node.scale.size() == 3) {
-    m = m * glm::mat4(glm::vec4(float(node.scale[0]), 0, 0, 0), glm::vec4(0, float(node.scale[1]), 0, 0),
+    m = m * glm::mat4(glm::vec4(float(node.scale[0]), 0, 0, 0),
+                      glm::vec4(0, float(node.scale[1]), 0, 0),
                       glm::vec4(0, 0, float(node.scale[2]), 0), glm::vec4(0, 0, 0, 1));
   }
   return m;
@@ -613,8 +619,8 @@ struct Flattener {
     for (size_t k = 0; k < mesh.primitives.size(); ++k) {
       const tg::Primitive& p = mesh.primitives[k];
       std::string pwhat = what + " primitive " + std::to_string(k);
-      if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES && p.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-          p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+      if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES &&
+          p.mode != TINYGLTF_MODE_TRIANGLE_STRIP && p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
         builder.mesh.warnings.push_back(pwhat + ": points and lines are not drawn");
         continue;
       }
@@ -622,7 +628,8 @@ struct Flattener {
       Piece piece;
       if (Status s = read_piece(model, p, pwhat, piece); !s.ok()) return s;
       if (piece.triangles.empty()) empty.insert({index, k});
-      if (Status s = append(builder, piece, world, material_for(p.material), pwhat); !s.ok()) return s;
+      if (Status s = append(builder, piece, world, material_for(p.material), pwhat); !s.ok())
+        return s;
     }
     return {};
   }
@@ -694,7 +701,8 @@ Result<Mesh> gltf_to_mesh(GltfDocument& doc, const std::string& name, const std:
   Flattener f{m, b, -1, std::vector<bool>(m.nodes.size(), false), {}};
   Status status;
   if (m.nodes.empty()) {  // meshes without nodes: each drawn once, untransformed
-    for (size_t i = 0; i < m.meshes.size() && status.ok(); ++i) status = f.add_mesh(int(i), glm::mat4(1.0f));
+    for (size_t i = 0; i < m.meshes.size() && status.ok(); ++i)
+      status = f.add_mesh(int(i), glm::mat4(1.0f));
   } else {
     for (int root : roots(m)) {
       status = f.walk(root);

@@ -182,8 +182,8 @@ Result<Mesh> load_model(const std::string& path) {
     return load_gltf(path);  // a .gltf or .glb name whose content is not one says why
   }
   if (const char* what = not_a_model(head)) {
-    return fail(path,
-                std::string("this is ") + what + ", not a model (softrast reads OBJ, PLY, STL and glTF)");
+    return fail(path, std::string("this is ") + what +
+                          ", not a model (softrast reads OBJ, PLY, STL and glTF)");
   }
   if (ext == ".stl") return load_stl(path);  // says why it is not one
   if (ext == ".ply") return load_ply(path);
