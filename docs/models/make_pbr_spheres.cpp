@@ -2,7 +2,7 @@
 // spheres of a gold base colour, roughness 0 to 1 from left to right, metallic 0 to 1 from top to
 // bottom, with the tests' glTF writer (tests/gltf_util.hpp). Build and run from the repository:
 //   g++ -std=c++20 -Iinclude -Itests docs/models/make_pbr_spheres.cpp -o /tmp/make_pbr_spheres \
-//     build/release/libsoftrast.a $(pkg-config --libs spng) -ljpeg -lz -lpthread
+//     build/release/libsoftrast.a $(pkg-config --libs spng stb) -ljpeg -lz -lpthread
 //   /tmp/make_pbr_spheres docs/models/pbr_spheres.glb
 #include <cstdio>
 #include <fstream>

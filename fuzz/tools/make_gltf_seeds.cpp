@@ -25,8 +25,8 @@ int main(int argc, char** argv) {
   }
   std::filesystem::path dir = argv[1];
   std::filesystem::create_directories(dir);
-  std::string png = softrast::test::checker_png((dir / "checker.png.tmp").string());
-  std::filesystem::remove(dir / "checker.png.tmp");
+  std::string png = softrast::test::checker_png((dir / "checker_tmp.png").string());
+  std::filesystem::remove(dir / "checker_tmp.png");
   GltfParts cube = softrast::test::textured_cube(png);
   save(dir, "cube.gltf", softrast::test::as_gltf(cube));
   save(dir, "cube.glb", softrast::test::as_glb(cube));
