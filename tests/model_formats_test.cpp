@@ -289,11 +289,8 @@ TEST_F(ModelFormatsTest, FilesThatAreNotModelsSayWhatTheyAre) {
   write("models.zip", std::string("PK\x03\x04", 4) + std::string(26, '\0'));
   write("paper.pdf", "%PDF-1.7\n");
   const std::pair<const char*, const char*> cases[] = {
-      {"tex.png", "a PNG image"},
-      {"tex.jpg", "a JPEG image"},
-      {"tex.tga", "a TGA image"},
-      {"models.zip", "a ZIP archive"},
-      {"paper.pdf", "a PDF document"},
+      {"tex.png", "a PNG image"},      {"tex.jpg", "a JPEG image"},     {"tex.tga", "a TGA image"},
+      {"models.zip", "a ZIP archive"}, {"paper.pdf", "a PDF document"},
   };
   for (auto [name, what] : cases) {
     std::string path = (dir_ / name).string();

@@ -37,16 +37,15 @@ PbrMaterial fallback_material(const Mesh& mesh, int index, const RenderOptions& 
 }
 
 struct BlendTriangle {
-  float depth;         // view depth of the centroid: larger is farther
-  uint32_t run;        // into the runs
-  uint32_t first;      // into mesh.indices
+  float depth;     // view depth of the centroid: larger is farther
+  uint32_t run;    // into the runs
+  uint32_t first;  // into mesh.indices
 };
 
 }  // namespace
 
 void render_pbr(Framebuffer& fb, const Mesh& mesh, const Camera& camera, const glm::mat4& mvp,
-                std::span<const SubMesh> runs, const RenderState& state,
-                const RenderOptions& opt) {
+                std::span<const SubMesh> runs, const RenderState& state, const RenderOptions& opt) {
   std::vector<PbrMaterial> materials;
   materials.reserve(runs.size());
   for (const SubMesh& run : runs) {
@@ -112,8 +111,9 @@ void render_pbr(Framebuffer& fb, const Mesh& mesh, const Camera& camera, const g
     }
   }
   // Blended triangles, farthest first; consecutive triangles of one run drawn together.
-  std::stable_sort(blended.begin(), blended.end(),
-                   [](const BlendTriangle& a, const BlendTriangle& b) { return a.depth > b.depth; });
+  std::stable_sort(
+      blended.begin(), blended.end(),
+      [](const BlendTriangle& a, const BlendTriangle& b) { return a.depth > b.depth; });
   std::vector<uint32_t> batch;
   for (size_t i = 0; i < blended.size();) {
     uint32_t run = blended[i].run;

@@ -25,14 +25,14 @@ SOFTRAST_SIMD_INLINE simd::Float<N> fast_exp2(const simd::Float<N>& x) {
   using F = simd::Float<N>;
   using I = simd::Int<N>;
   F xc = simd::clamp(x, F(-126.0f), F(126.0f));
-  I i = simd::to_int(xc);              // truncates towards zero
-  i = i + (simd::to_float(i) > xc);    // the mask is -1 where truncation went up: floor
+  I i = simd::to_int(xc);            // truncates towards zero
+  i = i + (simd::to_float(i) > xc);  // the mask is -1 where truncation went up: floor
   F f = xc - simd::to_float(i);
-  F p = F(1.0f) + f * (F(0.693147181f) +
-                       f * (F(0.240226507f) +
-                            f * (F(0.0555041087f) +
-                                 f * (F(0.00961812911f) + f * (F(0.00133335581f) +
-                                                               f * F(0.000154035304f))))));
+  F p = F(1.0f) +
+        f * (F(0.693147181f) +
+             f * (F(0.240226507f) +
+                  f * (F(0.0555041087f) + f * (F(0.00961812911f) +
+                                               f * (F(0.00133335581f) + f * F(0.000154035304f))))));
   return p * simd::bit_cast_float((i + I(127)) << 23);
 }
 
@@ -98,8 +98,8 @@ SOFTRAST_SIMD_INLINE simd::Vec3<N> mix3(const simd::Vec3<N>& a, const simd::Vec3
 
 // Linear radiances and the key light's irradiance; the CLI's defaults are in pbr_render.cpp.
 struct PbrLight {
-  glm::vec3 sky{0.0f};     // radiance of the upper hemisphere (world +y)
-  glm::vec3 ground{0.0f};  // radiance of the lower hemisphere
+  glm::vec3 sky{0.0f};                        // radiance of the upper hemisphere (world +y)
+  glm::vec3 ground{0.0f};                     // radiance of the lower hemisphere
   glm::vec3 key_direction{0.0f, 0.0f, 1.0f};  // towards the key light, normalised
   glm::vec3 key{0.0f};                        // its irradiance on a surface facing it
   float exposure_scale = 1.0f;                // 2^exposure
@@ -130,15 +130,14 @@ struct PbrShader {
     const glm::vec2& uv = m.uvs[i];
     glm::vec2 uv1 = m.uvs1.empty() ? uv : m.uvs1[i];
     glm::vec4 c = m.colors.empty() ? glm::vec4(1.0f) : m.colors[i];
-    const float values[kVaryings] = {n.x,   n.y,   n.z,  t.x, t.y, t.z, t.w, uv.x,
-                                     uv.y,  uv1.x, uv1.y, c.r, c.g, c.b, c.a};
+    const float values[kVaryings] = {n.x,  n.y,   n.z,   t.x, t.y, t.z, t.w, uv.x,
+                                     uv.y, uv1.x, uv1.y, c.r, c.g, c.b, c.a};
     for (int k = 0; k < kVaryings; ++k) v[k] = values[k];
     return in.clip(i);
   }
 
   template <int N>
-  SOFTRAST_SIMD_INLINE simd::Vec2<N> slot_uv(const TextureSlot& slot,
-                                             const Fragments<N>& f) const {
+  SOFTRAST_SIMD_INLINE simd::Vec2<N> slot_uv(const TextureSlot& slot, const Fragments<N>& f) const {
     simd::Vec2<N> uv = f.vec2(slot.uv_set == 1 ? 9 : 7);
     if (!slot.transformed) return uv;
     using F = simd::Float<N>;
@@ -150,7 +149,8 @@ struct PbrShader {
   SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_slot(const TextureSlot& slot,
                                                  const Fragments<N>& f) const {
     simd::Vec2<N> uv = slot_uv(slot, f);
-    if (slot.sampler.filter != Filter::kTrilinear) return sample<N>(*slot.texture, slot.sampler, uv);
+    if (slot.sampler.filter != Filter::kTrilinear)
+      return sample<N>(*slot.texture, slot.sampler, uv);
     return sample<N>(*slot.texture, slot.sampler, uv, {f.ddx(uv.x), f.ddx(uv.y)},
                      {f.ddy(uv.x), f.ddy(uv.y)});
   }
@@ -212,8 +212,8 @@ struct PbrShader {
     c = {c.x * F(k.r), c.y * F(k.g), c.z * F(k.b), c.w * F(k.a)};
     if (material->base_color_map) {
       simd::Vec4<N> t = sample_slot(material->base_color_map, f);
-      c = {c.x * srgb_to_linear<N>(t.x), c.y * srgb_to_linear<N>(t.y),
-           c.z * srgb_to_linear<N>(t.z), c.w * t.w};
+      c = {c.x * srgb_to_linear<N>(t.x), c.y * srgb_to_linear<N>(t.y), c.z * srgb_to_linear<N>(t.z),
+           c.w * t.w};
     }
     return c;
   }
@@ -270,8 +270,8 @@ struct PbrShader {
     V3 env_diffuse = mix3<N>(ground, sky, F(0.5f) + F(0.5f) * n.y);
     F r_y = F(2.0f) * n_v * n.y - v.y;  // reflect(-v, n).y
     F width = simd::max(a, F(0.02f));
-    V3 env_specular = mix3<N>(ground, sky, simd::clamp(F(0.5f) + r_y / (F(2.0f) * width),
-                                                      F(0.0f), F(1.0f)));
+    V3 env_specular =
+        mix3<N>(ground, sky, simd::clamp(F(0.5f) + r_y / (F(2.0f) * width), F(0.0f), F(1.0f)));
     // Karis' fit of the split-sum integral: F0 * scale + bias.
     F rx = roughness * F(-1.0f) + F(1.0f), ry = roughness * F(-0.0275f) + F(0.0425f);
     F rz = roughness * F(-0.572f) + F(1.04f), rw = roughness * F(0.022f) + F(-0.04f);
@@ -288,8 +288,8 @@ struct PbrShader {
     V3 emissive = simd::splat3<N>(mat.emissive);
     if (mat.emissive_map) {
       simd::Vec4<N> t = sample_slot(mat.emissive_map, f);
-      emissive = emissive * V3{srgb_to_linear<N>(t.x), srgb_to_linear<N>(t.y),
-                               srgb_to_linear<N>(t.z)};
+      emissive =
+          emissive * V3{srgb_to_linear<N>(t.x), srgb_to_linear<N>(t.y), srgb_to_linear<N>(t.z)};
     }
     color = (color + emissive) * F(light.exposure_scale);
     V3 mapped = tone_map_neutral<N>(color);
