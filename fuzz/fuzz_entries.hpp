@@ -48,4 +48,9 @@ int fuzz_cli_args(const uint8_t* data, size_t size);
 // oracle, both rasterizers and both draw paths identical).
 int fuzz_geometry(const uint8_t* data, size_t size);
 
+// glTF or GLB from memory (see gltf_fuzz.cpp): parse and validate, read every accessor, flatten
+// into a mesh and check it (indices in range, finite positions, attribute counts), render it with
+// the pbr shader at 16x16; an error must be one line starting with the file name.
+int fuzz_gltf(const uint8_t* data, size_t size);
+
 }  // namespace softrast::fuzz

@@ -10,7 +10,8 @@ packages=(
   libjpeg62-turbo-dev        # JPEG decoding (size known before allocation) and JPEG writing
   zlib1g-dev                 # PNG writing (level 1, strips compressed in parallel); test PNGs
   libcli11-dev               # the command line
-  nlohmann-json3-dev         # JSON: batch job lines, --json records (header-only)
+  nlohmann-json3-dev         # JSON: batch job lines, --json records, glTF (header-only)
+  libtinygltf-dev            # glTF 2.0 / GLB parsing (compiled in from its header)
   libgtest-dev               # the test suite
   libbenchmark-dev           # the micro-benchmarks (bench/), built but never run by the tests
   libosmesa6-dev libgl-dev   # Mesa llvmpipe, the reference renderer of the difference tests

@@ -160,8 +160,8 @@ TEST_F(CliIoTest, PlyAndStlModelsRenderAndOtherFilesSayWhatTheyAre) {
   CliResult png = run("obj.png -o x.png");
   EXPECT_EQ(png.exit_code, 1);
   EXPECT_EQ(png.err,
-            "softrast: error: obj.png: this is a PNG image, not a model (softrast reads OBJ, PLY "
-            "and STL)\n");
+            "softrast: error: obj.png: this is a PNG image, not a model (softrast reads OBJ, PLY, "
+            "STL and glTF)\n");
   EXPECT_FALSE(fs::exists(dir_ / "x.png"));
 }
 

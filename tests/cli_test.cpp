@@ -558,7 +558,9 @@ TEST_F(CliTest, EmptyFolderIsAnError) {
   write("nothing/notes.txt", "no models here\n");
   CliRun r = run("nothing -o out.png");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(r.err, "softrast: error: nothing: no model files (.obj, .ply, .stl) in this folder\n");
+  EXPECT_EQ(r.err,
+            "softrast: error: nothing: no model files (.obj, .ply, .stl, .gltf, .glb) in this "
+            "folder\n");
 }
 
 // ---------------------------------------------------------------------------------------------

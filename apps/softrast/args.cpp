@@ -66,7 +66,8 @@ void define_camera_flags(CLI::App& app, RawArgs& a) {
 
 void define_shading_flags(CLI::App& app, RawArgs& a) {
   app.add_option("--shader", a.shader,
-                 "flat, gouraud, texture, phong, normals, depth or wireframe (default phong); "
+                 "flat, gouraud, texture, phong, normals, depth, wireframe or pbr (default phong; "
+                 "pbr for glTF models: metallic-roughness materials under a sky and a key light); "
                  "depth is the depth view (grey by distance), not the depth test (--depth)")
       ->type_name("NAME");
   app.add_flag("--wireframe", a.wireframe, "Draw the visible triangle edges over any shader");
@@ -103,6 +104,10 @@ void define_shading_flags(CLI::App& app, RawArgs& a) {
   app.add_option("--light-intensity", a.light_intensity,
                  "Strength of the diffuse and specular light, 0 to 100 (default 1)")
       ->type_name("I");
+  app.add_option("--exposure", a.exposure,
+                 "Exposure of the pbr shader in stops, -20 to 20: each +1 doubles the light "
+                 "before tone mapping (default 0)")
+      ->type_name("EV");
   app.add_option("--alpha", a.alpha,
                  "The model's opacity, 0 to 1, written to the image's alpha channel; with --blend "
                  "alpha what is behind shows through (default 1). See --background for the "

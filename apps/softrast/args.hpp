@@ -19,7 +19,7 @@ struct RawArgs {
   std::string up_axis = "+y";
   std::optional<std::string> view;
   std::optional<float> azimuth, elevation, zoom;
-  std::string shader = "phong";
+  std::string shader;  // empty: phong, or pbr for glTF models (JobSpec::auto_shader)
   bool wireframe = false;
   std::optional<std::string> texture;
   std::optional<std::string> color;
@@ -28,6 +28,7 @@ struct RawArgs {
   std::string maps = "all";              // which material maps phong uses
   bool srgb = false;                     // the linear workflow (sRGB textures and output)
   std::optional<float> ambient, light_intensity;
+  std::optional<float> exposure;
   std::optional<std::string> edge_color;
   std::optional<std::string> background;
   std::string cull = "none";

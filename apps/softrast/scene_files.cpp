@@ -16,7 +16,8 @@ namespace fs = std::filesystem;
 
 // The extensions a folder's model files have (compared in lower case); each file is then read by
 // load_model(), which tells the formats apart by content.
-constexpr std::array<std::string_view, 3> kModelExtensions = {".obj", ".ply", ".stl"};
+constexpr std::array<std::string_view, 5> kModelExtensions = {".obj", ".ply", ".stl", ".gltf",
+                                                              ".glb"};
 
 std::string lowercase(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(),

@@ -87,9 +87,9 @@ constexpr std::array<Named<RenderOptions::Maps>, 3> kMapChoices = {
     {{"all", RenderOptions::Maps::kAll},
      {"diffuse", RenderOptions::Maps::kDiffuse},
      {"none", RenderOptions::Maps::kNone}}};
-constexpr std::array<ShaderKind, 7> kShaderKinds = {
-    ShaderKind::kFlat,    ShaderKind::kGouraud, ShaderKind::kTexture,  ShaderKind::kPhong,
-    ShaderKind::kNormals, ShaderKind::kDepth,   ShaderKind::kWireframe};
+constexpr std::array<ShaderKind, 8> kShaderKinds = {
+    ShaderKind::kFlat,    ShaderKind::kGouraud, ShaderKind::kTexture,   ShaderKind::kPhong,
+    ShaderKind::kNormals, ShaderKind::kDepth,   ShaderKind::kWireframe, ShaderKind::kPbr};
 
 Result<ShaderKind> shader_named(const std::string& name) {
   if (std::optional<ShaderKind> kind = parse_shader_kind(name)) return *kind;
@@ -132,7 +132,12 @@ void interpret_state(const RawArgs& a, RenderState& state, FirstError& e) {
 }
 
 void interpret_shading(const RawArgs& a, RenderOptions& options, FirstError& e) {
-  e.take(shader_named(a.shader), options.shader);
+  e.take(shader_named(a.shader.empty() ? "phong" : a.shader), options.shader);
+  if (a.exposure) {
+    e.fail_if(!(*a.exposure >= -20.0f && *a.exposure <= 20.0f),
+              "--exposure: must be in [-20, 20] stops");
+    options.exposure = *a.exposure;
+  }
   options.wireframe_overlay = a.wireframe;
   if (a.color) {
     glm::vec4 color(0.0f);
@@ -296,6 +301,15 @@ Result<std::shared_ptr<const Texture>> load_texture(const std::string& path) {
       std::make_shared<Texture>(Texture::from_image(*image, ColorSpace::kSrgb)));
 }
 
+}  // namespace
+
+bool has_pbr_materials(const Mesh& mesh) {
+  return std::any_of(mesh.materials.begin(), mesh.materials.end(),
+                     [](const Material& m) { return m.pbr.has_value(); });
+}
+
+namespace {
+
 double milliseconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
@@ -364,6 +378,7 @@ Result<JobSpec> interpret(const RawArgs& args) {
   spec.models = args.models;
   spec.texture = args.texture;
   spec.headlight = !args.light && !args.light_pos;
+  spec.auto_shader = args.shader.empty();
   if (args.models.empty()) {
     e.fail_if(args.up_axis != "+y" || args.view || args.azimuth || args.elevation || args.zoom,
               "--up-axis, --view, --azimuth, --elevation and --zoom frame a model; the demo "
@@ -398,6 +413,7 @@ Result<Job> prepare(const JobSpec& spec, const Loaders& loaders) {
     glm::mat3 camera_to_world = glm::transpose(glm::mat3(scene->camera.view()));
     options.light_direction = camera_to_world * glm::normalize(options.light_direction);
   }
+  if (spec.auto_shader && has_pbr_materials(scene->mesh)) options.shader = ShaderKind::kPbr;
   Job job(std::move(*scene), std::move(*framebuffer));
   job.options = std::move(options);
   job.background = spec.background;

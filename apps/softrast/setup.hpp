@@ -37,6 +37,8 @@ struct JobSpec {
   // No --light: the light follows the camera (options.light_direction is then taken in the
   // camera's frame: x right, y up, z towards the viewer).
   bool headlight = true;
+  // No --shader: phong, or pbr once the scene turns out to have glTF (PBR) materials.
+  bool auto_shader = false;
   glm::vec4 background{0.1f, 0.1f, 0.1f, 1.0f};
   int frames = 0;  // 0: one untimed render
   bool quiet = false;
@@ -53,6 +55,9 @@ struct Scene {
   // "softrast: warning: " lines to print before rendering (the message part).
   std::vector<std::string> warnings;
 };
+
+// True if any material is a glTF one (Material::pbr): such scenes default to the pbr shader.
+bool has_pbr_materials(const Mesh& mesh);
 
 // What run_job() needs: everything loaded and validated.
 struct Job {

@@ -100,7 +100,8 @@ void define_view_flags(CLI::App& app, ViewArgs& a) {
   app.add_option("MODEL", a.models, "Wavefront OBJ files shown together; none: the demo scene");
   app.add_option("--size", r.size, "Initial window size (default 1280x720)")->type_name("WxH");
   app.add_option("--shader", r.shader,
-                 "flat, gouraud, texture, phong, normals, depth or wireframe (default phong)")
+                 "flat, gouraud, texture, phong, normals, depth, wireframe or pbr (default phong; "
+                 "pbr for glTF models)")
       ->type_name("NAME");
   app.add_flag("--wireframe", r.wireframe, "Start with the wireframe overlay on");
   app.add_option("--cull", r.cull,
@@ -140,9 +141,9 @@ int view_command(const ViewArgs&, void (*report)(std::string message)) {
 
 namespace {
 
-constexpr std::array<ShaderKind, 7> kShaderCycle = {
-    ShaderKind::kPhong,   ShaderKind::kFlat,  ShaderKind::kGouraud,  ShaderKind::kTexture,
-    ShaderKind::kNormals, ShaderKind::kDepth, ShaderKind::kWireframe};
+constexpr std::array<ShaderKind, 8> kShaderCycle = {
+    ShaderKind::kPhong,   ShaderKind::kFlat,  ShaderKind::kGouraud,   ShaderKind::kTexture,
+    ShaderKind::kNormals, ShaderKind::kDepth, ShaderKind::kWireframe, ShaderKind::kPbr};
 constexpr std::array<DebugView, 5> kDebugCycle = {DebugView::kNone, DebugView::kTiles,
                                                   DebugView::kOverdraw, DebugView::kCost,
                                                   DebugView::kTriangles};
@@ -520,6 +521,7 @@ int view_command(const ViewArgs& args, void (*report)(std::string message)) {
     report(scene.status().message());
     return kExitRuntime;
   }
+  if (spec->auto_shader && has_pbr_materials(scene->mesh)) spec->options.shader = ShaderKind::kPbr;
   if (!spec->quiet) {
     std::fprintf(stderr, "loaded %s: %zu triangles\n", scene->source.c_str(),
                  scene->mesh.triangle_count());

@@ -52,6 +52,8 @@ done
 # were rendered for their own section).
 if [ "${ONLY:-all}" != materials ]; then
 # After: this tree.
+# glTF with the pbr shader, chosen without flags (README, "glTF 2.0 and PBR").
+$new "$here/../models/pbr_spheres.glb" --size 640x640 -o "$out/pbr_spheres.png"
 $new $head --texture "$head_tex" --view back $size -o "$out/head_back_after.png"
 $new $head --texture "$head_tex" --view right $size -o "$out/head_side_after.png"
 $new "$models/floor.obj" --texture "$models/floor_diffuse.tga" --wireframe $size \

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "softrast/pbr_material.hpp"
 #include "softrast/status.hpp"
 #include "softrast/texture.hpp"
 
@@ -37,6 +39,10 @@ struct Material {
   NormalSpace normal_space = NormalSpace::kTangent;
   float normal_scale = 1.0f;                 // -bm: scales the map's x and y (its slope)
   std::shared_ptr<const Texture> alpha_map;  // map_d: its red channel multiplies the alpha
+  // glTF's metallic-roughness material (set by the glTF loader, which also sets diffuse and
+  // diffuse_map to the base colour for the other shaders); ShaderKind::kPbr draws a material
+  // without one as a dielectric of its diffuse colour.
+  std::optional<PbrMaterial> pbr;
 };
 
 // A run of indices drawn with one material.
@@ -114,10 +120,33 @@ Result<Mesh> load_ply(const std::string& path);
 // one or not finite, no triangles.
 Result<Mesh> load_stl(const std::string& path);
 
-// Loads a model, telling the format by content: PLY by its "ply" line, binary STL by its size,
-// ASCII STL by "solid", OBJ otherwise. A file that looks like something else is refused with what
-// it looks like: "x.png: this is a PNG image, not a model (softrast reads OBJ, PLY and STL)"
-// (PNG, JPEG, GIF, BMP, TGA images, glTF/GLB scenes, ZIP, PDF, gzip, ELF, FBX). A .stl or .ply
+// Largest glTF or GLB file, and largest external buffer, load_gltf reads: 1 GiB.
+inline constexpr int64_t kMaxGltfFileBytes = int64_t(1) << 30;
+// Largest flattened glTF mesh: 2^24 vertices and 2^25 triangles (some 1.6 GiB of mesh), checked
+// before each primitive is added (a mesh instanced by many nodes counts once per node).
+inline constexpr int64_t kMaxGltfVertices = int64_t(1) << 24;
+inline constexpr int64_t kMaxGltfTriangles = int64_t(1) << 25;
+
+// Loads a glTF 2.0 scene (.gltf with external or data-URI buffers, or .glb) as one mesh: the
+// default scene's node hierarchy flattened into world space (positions, normals, tangents with
+// their handedness kept under mirroring transforms, the winding of mirrored nodes reversed), one
+// SubMesh per primitive instance, one Material (with `pbr` set) per glTF material. Triangles,
+// strips and fans are drawn; points and lines are skipped with a warning. Missing normals are
+// flat; missing tangents are computed where a material has a normal map. Extensions:
+// KHR_texture_transform, KHR_materials_emissive_strength, KHR_mesh_quantization; any other in
+// extensionsRequired is an error. Images are PNG, JPEG or TGA through load_image's decoders; a
+// missing or unreadable image is a warning. Errors are one line naming the file and the object
+// ("scene.gltf: accessor 3: 24 elements of 12 bytes need 288 bytes from byte 0, but bufferView 1
+// has 200"): invalid JSON or GLB framing, a buffer file missing or of the wrong size, a data URI
+// that is not base64, an index out of range, accessors past their bufferView, sparse accessors,
+// non-finite positions, counts over kMaxGltfVertices / kMaxGltfTriangles, no triangles.
+Result<Mesh> load_gltf(const std::string& path);
+
+// Loads a model, telling the format by content: glTF by "{ ... "asset"" or GLB's magic, PLY by
+// its "ply" line, binary STL by its size, ASCII STL by "solid", OBJ otherwise. A file that looks
+// like something else is refused with what it looks like: "x.png: this is a PNG image, not a
+// model (softrast reads OBJ, PLY, STL and glTF)" (PNG, JPEG, GIF, BMP, TGA images, ZIP, PDF,
+// gzip, ELF, FBX). A .stl or .ply
 // name whose content is neither goes to that format's loader, which says why it is not one.
 // Pipes and devices (which can be read only once) are read as OBJ.
 Result<Mesh> load_model(const std::string& path);

@@ -28,6 +28,8 @@ enum class ShaderKind {
   kDepth,      // debug: view depth as grey on a log scale, white at the nearest visible
                // pixel, black at the farthest (the ramp spans the depth range in the image)
   kWireframe,  // triangle edges in the albedo colour, after culling
+  kPbr,        // glTF metallic-roughness (PbrMaterial), sky/ground light plus the key light,
+               // tone-mapped and sRGB-encoded; the default for glTF models
 };
 std::optional<ShaderKind> parse_shader_kind(std::string_view name);
 const char* shader_kind_name(ShaderKind kind);
@@ -72,6 +74,8 @@ struct RenderOptions {
   // A picture of the pipeline's work instead of (tiles, cost: over) the shaded image. The
   // overdraw view replaces every pixel's colour; the others draw like a shader.
   DebugView debug_view = DebugView::kNone;
+  // kPbr: the exposure in stops (the linear colour is scaled by 2^exposure before the tone map).
+  float exposure = 0.0f;
 };
 
 // Draws `mesh` (positions in world space) seen by `camera` into `framebuffer`, which is not

@@ -1,4 +1,4 @@
-// io/model_loader.cpp: load_model, which tells OBJ, PLY and STL apart by their contents and
+// io/model_loader.cpp: load_model, which tells OBJ, PLY, STL and glTF apart by their contents and
 // says what a file that is none of them looks like; load_ply and load_stl.
 
 #include <sys/stat.h>
@@ -35,11 +35,10 @@ struct Signature {
 };
 
 // Files people give as a model by mistake, by their first bytes.
-constexpr std::array<Signature, 10> kNotModels = {{
+constexpr std::array<Signature, 9> kNotModels = {{
     {"\x89PNG\r\n\x1a\n", "a PNG image"},
     {"\xff\xd8\xff", "a JPEG image"},
     {"GIF8", "a GIF image"},
-    {"glTF", "a binary glTF (GLB) scene"},
     {"PK\x03\x04", "a ZIP archive"},
     {"%PDF", "a PDF document"},
     {"\x1f\x8b", "a gzip-compressed file"},
@@ -76,7 +75,6 @@ const char* not_a_model(std::string_view head) {
     if (s.bytes == "BM" && (head.size() < 14 || head[6] || head[7] || head[8] || head[9])) continue;
     return s.what;
   }
-  if (looks_like_gltf(head)) return "a glTF scene (JSON)";
   // TGA has no signature; its strict header test never passes on text (the second byte, the
   // colour map type, must be 0 or 1).
   if (detail::is_tga(reinterpret_cast<const uint8_t*>(head.data()), head.size())) {
@@ -179,11 +177,14 @@ Result<Mesh> load_model(const std::string& path) {
     return load_whole(path, Kind::kBinaryStl);
   }
   if (starts_solid(head)) return load_whole(path, Kind::kAsciiStl);
-  if (const char* what = not_a_model(head)) {
-    return fail(path,
-                std::string("this is ") + what + ", not a model (softrast reads OBJ, PLY and STL)");
-  }
   std::string ext = lowercase_extension(path);
+  if (starts_with(head, "glTF") || looks_like_gltf(head) || ext == ".gltf" || ext == ".glb") {
+    return load_gltf(path);  // a .gltf or .glb name whose content is not one says why
+  }
+  if (const char* what = not_a_model(head)) {
+    return fail(path, std::string("this is ") + what +
+                          ", not a model (softrast reads OBJ, PLY, STL and glTF)");
+  }
   if (ext == ".stl") return load_stl(path);  // says why it is not one
   if (ext == ".ply") return load_ply(path);
   return load_obj(path);

@@ -8,12 +8,13 @@
 
 #include "debug/debug_render.hpp"
 #include "shaders/builtin_shaders.hpp"
+#include "shaders/pbr_render.hpp"
 #include "softrast/renderer.hpp"
 
 namespace softrast {
 namespace {
 
-constexpr std::array<std::pair<ShaderKind, const char*>, 7> kShaderNames = {{
+constexpr std::array<std::pair<ShaderKind, const char*>, 8> kShaderNames = {{
     {ShaderKind::kFlat, "flat"},
     {ShaderKind::kGouraud, "gouraud"},
     {ShaderKind::kTexture, "texture"},
@@ -21,6 +22,7 @@ constexpr std::array<std::pair<ShaderKind, const char*>, 7> kShaderNames = {{
     {ShaderKind::kNormals, "normals"},
     {ShaderKind::kDepth, "depth"},
     {ShaderKind::kWireframe, "wireframe"},
+    {ShaderKind::kPbr, "pbr"},
 }};
 
 // What one submesh is drawn with.
@@ -137,7 +139,8 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
       const Texture* t = surf.texture ? surf.texture : &kWhite;
       return draw(fb, state, TextureShader{in, t, sampler, opt.alpha, opt.srgb}, indices, n);
     }
-    case ShaderKind::kPhong: {
+    case ShaderKind::kPhong:
+    case ShaderKind::kPbr: {  // pbr is drawn by render_pbr; phong if it ever gets here
       SurfaceMaps maps = surf.maps;
       bool tangents = maps.normal && !maps.object_space;
       if (tangents && mesh.tangents.size() == mesh.positions.size()) {
@@ -255,19 +258,23 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
     shadow = detail::build_shadow_map(mesh, options.light_direction, options.shadow_map_size,
                                       options.state.threads);
   }
-  // Opaque runs first, then (when the state is opaque, as by default) the translucent ones
-  // blended over them without writing depth, in submission order.
-  RenderState blended = state;
-  blended.blend = BlendMode::kAlpha;
-  blended.depth_write = false;
-  for (bool second_pass : {false, true}) {
-    for (const SubMesh& run : runs) {
-      Surface surf = surface_of(mesh, run.material, options);
-      bool late = state.blend == BlendMode::kOpaque && translucent(surf, options);
-      if (late != second_pass) continue;
-      std::span<const uint32_t> indices(mesh.indices.data() + run.first_index, run.index_count);
-      draw_run(framebuffer, late ? blended : state, mesh, camera, mvp, indices, surf, options,
-               options.shader, depth);
+  if (options.shader == ShaderKind::kPbr) {
+    detail::render_pbr(framebuffer, mesh, camera, mvp, runs, state, options);
+  } else {
+    // Opaque runs first, then (when the state is opaque, as by default) the translucent ones
+    // blended over them without writing depth, in submission order.
+    RenderState blended = state;
+    blended.blend = BlendMode::kAlpha;
+    blended.depth_write = false;
+    for (bool second_pass : {false, true}) {
+      for (const SubMesh& run : runs) {
+        Surface surf = surface_of(mesh, run.material, options);
+        bool late = state.blend == BlendMode::kOpaque && translucent(surf, options);
+        if (late != second_pass) continue;
+        std::span<const uint32_t> indices(mesh.indices.data() + run.first_index, run.index_count);
+        draw_run(framebuffer, late ? blended : state, mesh, camera, mvp, indices, surf, options,
+                 options.shader, depth, shadow ? &*shadow : nullptr);
+      }
     }
   }
   if (options.wireframe_overlay && options.shader != ShaderKind::kWireframe) {
