@@ -33,10 +33,10 @@ using P2 = std::array<double, 2>;
 
 struct Mesh {
   int width = 96, height = 96;
-  std::vector<P2> points;                  // window coordinates, y down
-  std::vector<std::array<int, 3>> faces;   // indices into points
-  std::vector<int> outline;                // the region's outline, as indices into points
-  bool grid = false;                       // points on the 1/256 grid, w = 1
+  std::vector<P2> points;                 // window coordinates, y down
+  std::vector<std::array<int, 3>> faces;  // indices into points
+  std::vector<int> outline;               // the region's outline, as indices into points
+  bool grid = false;                      // points on the 1/256 grid, w = 1
 };
 
 double cross(const P2& a, const P2& b, const P2& c) {
@@ -56,7 +56,6 @@ std::array<double, 4> random_rect(std::mt19937_64& rng, const Mesh& m) {
   double y0 = uniform(rng, -0.1, 0.4) * m.height, y1 = uniform(rng, 0.6, 1.1) * m.height;
   return {x0, y0, x1, y1};
 }
-
 
 Mesh fan(std::mt19937_64& rng) {
   Mesh m;
@@ -183,8 +182,8 @@ struct Tally {
 double segment_distance(const P2& a, const P2& b, const P2& p) {
   double ex = b[0] - a[0], ey = b[1] - a[1];
   double len2 = ex * ex + ey * ey;
-  double t = len2 > 0 ? std::clamp(((p[0] - a[0]) * ex + (p[1] - a[1]) * ey) / len2, 0.0, 1.0)
-                      : 0.0;
+  double t =
+      len2 > 0 ? std::clamp(((p[0] - a[0]) * ex + (p[1] - a[1]) * ey) / len2, 0.0, 1.0) : 0.0;
   double dx = p[0] - (a[0] + t * ex), dy = p[1] - (a[1] + t * ey);
   return std::sqrt(dx * dx + dy * dy);
 }
@@ -196,12 +195,13 @@ bool measure(const Mesh& m, std::mt19937_64& rng, Tally (&tally)[2]) {
   // Clip coordinates: on the grid (exact, w = 1) or float with a random w per vertex.
   std::vector<float> clip;
   std::vector<P2> window;  // the positions as drawn (after the grid snap)
+  // Grid meshes: half pixels (edges through centres and corners) or 1/256 steps.
+  double step = uniform_int(rng, 0, 1) ? 2.0 : 256.0;
   for (const P2& p : m.points) {
     double x = p[0], y = p[1], w = 1.0;
     if (m.grid) {
-      x = std::round(x * 2.0) / 2.0;  // half pixels: edges through centres and corners
-      y = std::round(y * 2.0) / 2.0;
-      if (uniform_int(rng, 0, 1)) x = std::round(p[0] * 256.0) / 256.0, y = std::round(p[1] * 256.0) / 256.0;
+      x = std::round(x * step) / step;
+      y = std::round(y * step) / step;
     } else {
       w = uniform(rng, 0.1, 4.0);
     }
@@ -215,9 +215,9 @@ bool measure(const Mesh& m, std::mt19937_64& rng, Tally (&tally)[2]) {
     const P2 &a = window[size_t(f[0])], &b = window[size_t(f[1])], &c = window[size_t(f[2])];
     double area2 = cross(a, b, c);
     if (orientation == 0) orientation = area2 > 0 ? 1 : -1;
-    double longest = std::max({std::hypot(b[0] - a[0], b[1] - a[1]),
-                               std::hypot(c[0] - b[0], c[1] - b[1]),
-                               std::hypot(a[0] - c[0], a[1] - c[1])});
+    double longest =
+        std::max({std::hypot(b[0] - a[0], b[1] - a[1]), std::hypot(c[0] - b[0], c[1] - b[1]),
+                  std::hypot(a[0] - c[0], a[1] - c[1])});
     if (!(area2 * orientation / longest > 0.01)) return false;
   }
   // The outline as drawn, and the shared edges.
@@ -231,7 +231,8 @@ bool measure(const Mesh& m, std::mt19937_64& rng, Tally (&tally)[2]) {
     }
   }
   std::vector<uint32_t> indices;
-  for (const auto& f : m.faces) indices.insert(indices.end(), {uint32_t(f[0]), uint32_t(f[1]), uint32_t(f[2])});
+  for (const auto& f : m.faces)
+    indices.insert(indices.end(), {uint32_t(f[0]), uint32_t(f[1]), uint32_t(f[2])});
   CountShader shader{clip.data()};
   for (int r = 0; r < 2; ++r) {
     Framebuffer fb(m.width, m.height);
@@ -281,7 +282,8 @@ bool measure(const Mesh& m, std::mt19937_64& rng, Tally (&tally)[2]) {
 
 TEST(Cracks, NoneAndNoDoubleHitsAlongSharedEdgesOfRandomMeshes) {
   int meshes = 300;
-  if (const char* text = std::getenv("SOFTRAST_CRACK_MESHES")) meshes = std::max(1, std::atoi(text));
+  if (const char* text = std::getenv("SOFTRAST_CRACK_MESHES"))
+    meshes = std::max(1, std::atoi(text));
   std::mt19937_64 rng(0xc7ac4);
   Tally tally[2];
   for (int n = 0; n < meshes; ++n) {
@@ -296,10 +298,11 @@ TEST(Cracks, NoneAndNoDoubleHitsAlongSharedEdgesOfRandomMeshes) {
   for (int r = 0; r < 2; ++r) {
     const Tally& t = tally[r];
     double per_million = 1e6 / double(std::max(1L, t.shared_edge_pixels));
-    std::printf("cracks %-15s %d meshes, %ld shared-edge pixels: %ld cracks (%.3f per million), "
-                "%ld double hits (%.3f per million); %ld interior pixels hit other than once\n",
-                names[r], meshes, t.shared_edge_pixels, t.cracks, t.cracks * per_million,
-                t.double_hits, t.double_hits * per_million, t.interior_wrong);
+    std::printf(
+        "cracks %-15s %d meshes, %ld shared-edge pixels: %ld cracks (%.3f per million), "
+        "%ld double hits (%.3f per million); %ld interior pixels hit other than once\n",
+        names[r], meshes, t.shared_edge_pixels, t.cracks, t.cracks * per_million, t.double_hits,
+        t.double_hits * per_million, t.interior_wrong);
     EXPECT_GT(t.shared_edge_pixels, 1000 * std::min(meshes, 100)) << names[r];
     EXPECT_EQ(t.cracks, 0) << names[r];
     EXPECT_EQ(t.double_hits, 0) << names[r];

@@ -24,8 +24,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <map>
 #include <set>
@@ -556,11 +556,11 @@ std::vector<SignalCase> signal_cases() {
                {"tri.obj", "-q", "--size", "1024x1024", "--frames", "100000", "-o", "out.png"},
                {},
                running});
-  // The image being written: 100 ms after each 64 KiB of a 4 MiB TGA.
+  // The image being written: a second after each 64 KiB of the TGA (RLE, about 180 KiB).
   c.push_back({"writing the image",
                {{"tri.obj", kTriangleObj}},
                {"tri.obj", "-q", "--size", "1024x1024", "-o", "out.tga"},
-               {"SOFTRAST_TEST_SLOW_WRITE_MS=100"},
+               {"SOFTRAST_TEST_SLOW_WRITE_MS=1000"},
                [](const fs::path& dir) { return has_temporary_file(dir); }});
   // A batch of 400 renders of 512x512, interrupted once the first image exists.
   std::string jobs;
@@ -584,10 +584,12 @@ TEST_F(HostileInput, SignalsEndTheProgramCleanly) {
       fs::path work = root_ / "work";
       fs::remove_all(work);
       fs::create_directories(work);
-      for (const auto& [file, bytes] : c.files) std::ofstream(work / file, std::ios::binary) << bytes;
+      for (const auto& [file, bytes] : c.files)
+        std::ofstream(work / file, std::ios::binary) << bytes;
       SignalOutcome r = run_and_signal(work, root_ / "logs", c, signal);
       ASSERT_TRUE(r.signalled) << "the program ended before it was busy: " << r.outcome.err;
-      EXPECT_FALSE(r.outcome.timed_out) << "still running " << kSignalSeconds << " s after the signal";
+      EXPECT_FALSE(r.outcome.timed_out)
+          << "still running " << kSignalSeconds << " s after the signal";
       EXPECT_LT(r.seconds_after_signal, kSignalSeconds);
       EXPECT_EQ(r.outcome.exit_code, 128 + signal) << "stderr: " << r.outcome.err;
       ASSERT_EQ(std::count(r.outcome.err.begin(), r.outcome.err.end(), '\n'), 1)
