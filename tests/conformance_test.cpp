@@ -3,7 +3,9 @@
 // path) and by llvmpipe (tools/reference/glconform: every case of a class in one process), and
 // compared by the class's rule:
 //   1. grid: vertices on the 1/256-pixel grid (exact in float, w a power of two): the number
-//      of hits of every pixel is identical.
+//      of hits of every pixel is identical (where llvmpipe differs from the exact oracle away
+//      from the edges, llvmpipe is wrong, and softrast must equal the oracle; those pixels are
+//      counted and printed).
 //   2. float: float vertices with perspective (w in [0.1, 4]): no pixel differs in hits outside
 //      a band of +-1/256 pixel around the edges (the exact edges, computed in double).
 //   3. colour: interpolated colour within 2/255 of a pixel of the other image within one pixel
@@ -494,14 +496,15 @@ struct Verdict {
   std::vector<bool> mask;
   int max_diff = 0;  // colour classes: largest channel difference at one position; depth: units
   double max_own = 0.0, max_other = 0.0;  // depth: softrast's and llvmpipe's largest error
+  long llvmpipe_wrong = 0;  // coverage: llvmpipe's pixels that differ from the exact oracle
 };
 
 Verdict judge(Rule rule, const Scene& s, const Rendered& soft, const Rendered* gl) {
   Verdict v;
   v.mask.assign(size_t(s.width) * s.height, false);
   Oracle o;
-  if (rule == Rule::kHitsOutsideBand || rule == Rule::kOracleOnly || rule == Rule::kColour2 ||
-      rule == Rule::kColour4 || rule == Rule::kDepth1) {
+  if (rule == Rule::kExactHits || rule == Rule::kHitsOutsideBand || rule == Rule::kOracleOnly ||
+      rule == Rule::kColour2 || rule == Rule::kColour4 || rule == Rule::kDepth1) {
     o = oracle(s);
   }
   if (rule == Rule::kLines) o = line_oracle(s);
@@ -511,12 +514,21 @@ Verdict judge(Rule rule, const Scene& s, const Rendered& soft, const Rendered* g
       bool bad = false;
       int hits = soft.pixel(x, y)[0];
       switch (rule) {
+        // Where llvmpipe differs from the exact oracle away from every edge, llvmpipe is wrong
+        // (Mesa 22.3.6 drops a whole draw of three triangles when the third is degenerate, a
+        // case the grid class found): counted in llvmpipe_wrong, and softrast is held to the
+        // oracle there.
         case Rule::kExactHits:
-          bad = hits != gl->pixel(x, y)[0];
+        case Rule::kHitsOutsideBand: {
+          int theirs = gl->pixel(x, y)[0];
+          if (o.ambiguous[at]) {
+            bad = rule == Rule::kExactHits && hits != theirs;
+          } else {
+            bad = hits != o.count[at];
+            v.llvmpipe_wrong += theirs != o.count[at];
+          }
           break;
-        case Rule::kHitsOutsideBand:
-          bad = !o.ambiguous[at] && (hits != gl->pixel(x, y)[0] || hits != o.count[at]);
-          break;
+        }
         case Rule::kOracleOnly:
           bad = !o.ambiguous[at] && hits != o.count[at];
           break;
@@ -709,6 +721,7 @@ void run_class(const ClassSpec& spec, int normal_count) {
   long mismatches = 0, pixels = 0;
   int saved = 0, max_diff = 0;
   double max_own = 0.0, max_other = 0.0;
+  long llvmpipe_wrong = 0;
   auto start = std::chrono::steady_clock::now();
   for (int done = 0; done < count; done += kBatch) {
     std::vector<Scene> scenes;
@@ -727,6 +740,7 @@ void run_class(const ClassSpec& spec, int normal_count) {
         Verdict v = judge(spec.rule, s, soft, g);
         max_diff = std::max(max_diff, v.max_diff);
         max_own = std::max(max_own, v.max_own);
+        llvmpipe_wrong += v.llvmpipe_wrong;
         max_other = std::max(max_other, v.max_other);
         mismatches += v.mismatches;
         if (v.mismatches > 0 && saved < 3) {
@@ -742,6 +756,12 @@ void run_class(const ClassSpec& spec, int normal_count) {
       "conformance %-14s %7d cases, %ld pixels x 2 rasterizers, %ld mismatches, max "
       "difference %d, %.1f s\n",
       spec.name.c_str(), count, pixels, mismatches, max_diff, seconds);
+  if (llvmpipe_wrong > 0) {
+    std::printf(
+        "conformance %-14s llvmpipe differs from the exact oracle at %ld pixels (counted "
+        "twice, once per softrast rasterizer)\n",
+        spec.name.c_str(), llvmpipe_wrong);
+  }
   if (spec.rule == Rule::kDepth1) {
     std::printf(
         "conformance %-14s largest error against the exact depth: softrast %.2f, llvmpipe "
