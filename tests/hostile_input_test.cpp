@@ -7,7 +7,8 @@
 // past the start; declared sizes of 10^9 pixels and 65535x65535; a texture over each size cap;
 // a 1 MiB line; NUL bytes; CRLF and lone CR line ends; NaN, Inf and 1e400; a face of 100,000
 // corners; a TGA RLE packet running past the image; an output path that is a folder or cannot
-// be written; --size at and past the largest image.
+// be written; --size at and past the largest image; SIGINT and SIGTERM during a long render,
+// while writing the image and during a batch.
 #ifdef SOFTRAST_CLI_PATH
 #include <fcntl.h>
 #include <sys/resource.h>
@@ -20,9 +21,11 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <map>
 #include <set>
@@ -325,6 +328,31 @@ class HostileInput : public testing::Test {
 
   // Runs one case in a fresh work folder; returns the output image's path if one was written.
   void run(const Case& c, Image* image = nullptr) {
+    run_case(c, image);
+    report_row(c.name, last_exit_, last_err_);
+  }
+
+  // With SOFTRAST_HOSTILE_REPORT=FILE, each case becomes a row of a Markdown table in FILE
+  // (docs/hostile_inputs.md is made so): the input, the exit code, the line on stderr.
+  static void report_row(const std::string& name, int exit_code, const std::string& err) {
+    const char* path = std::getenv("SOFTRAST_HOSTILE_REPORT");
+    if (!path) return;
+    static bool started = false;
+    std::ofstream out(path, started ? std::ios::app : std::ios::trunc);
+    if (!started) {
+      out << "| input | exit code | stderr |\n|---|---|---|\n";
+      started = true;
+    }
+    auto cell = [](std::string text) {
+      while (!text.empty() && text.back() == '\n') text.pop_back();
+      std::string escaped;
+      for (char ch : text) escaped += ch == '|' ? std::string("\\|") : std::string(1, ch);
+      return escaped.empty() ? std::string("(none)") : "`" + escaped + "`";
+    };
+    out << "| " << cell(name) << " | " << exit_code << " | " << cell(err) << " |\n";
+  }
+
+  void run_case(const Case& c, Image* image) {
     SCOPED_TRACE(c.name);
     fs::path work = root_ / "work";
     fs::remove_all(work);
@@ -334,6 +362,8 @@ class HostileInput : public testing::Test {
       std::ofstream(work / name, std::ios::binary) << bytes;
     }
     Outcome r = run_cli(work, root_ / "logs", c.args, c.max_seconds);
+    last_exit_ = r.exit_code;
+    last_err_ = r.err;
     EXPECT_FALSE(r.timed_out) << "took over " << c.max_seconds << " s";
     EXPECT_EQ(r.exit_code, c.exit_code) << "stderr: " << r.err;
     // Peak memory: the error cases read at most a few MiB (a sanitized build adds its shadow).
@@ -361,6 +391,8 @@ class HostileInput : public testing::Test {
   }
 
   fs::path root_;
+  int last_exit_ = 0;
+  std::string last_err_;
 };
 
 TEST_F(HostileInput, EveryCaseFailsCleanlyOrRendersCorrectly) {
@@ -411,6 +443,180 @@ TEST_F(HostileInput, ValidInputsRenderTheirContent) {
   }
   EXPECT_GT(blue, 5);
   EXPECT_GT(red + green, 2);
+}
+
+// ---------------------------------------------------------------------------------------------
+// SIGINT and SIGTERM while the program works: during a long render, while the image is being
+// written (the test hook SOFTRAST_TEST_SLOW_WRITE_MS slows the write down) and during a batch.
+// Each must end the program within kSignalSeconds of the signal, by the signal (a shell sees 130
+// or 143), with one error line naming it, and leave no temporary file and no partial output: an
+// output that exists is a complete image.
+
+constexpr double kSignalSeconds = 5.0;
+
+// Whether process `pid` has installed a handler for `signal` (bit signal - 1 of SigCgt).
+bool catches(pid_t pid, int signal) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("SigCgt:", 0) == 0) {
+      uint64_t mask = std::stoull(line.substr(7), nullptr, 16);
+      return (mask >> (signal - 1)) & 1;
+    }
+  }
+  return false;
+}
+
+bool has_temporary_file(const fs::path& dir) {
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    if (entry.path().filename().string().find(".tmp.") != std::string::npos) return true;
+  }
+  return false;
+}
+
+struct SignalCase {
+  std::string name;
+  std::map<std::string, Bytes> files;
+  std::vector<std::string> args;
+  std::vector<std::string> env;               // NAME=VALUE added to the environment
+  std::function<bool(const fs::path&)> busy;  // true once the program is where the case wants it
+};
+
+struct SignalOutcome {
+  Outcome outcome;
+  bool signalled = false;
+  double seconds_after_signal = 0.0;
+};
+
+// Runs the program, sends `signal` once it catches it and `busy` holds, waits for its end (killed
+// after kSignalSeconds, or after 120 s if it never got busy).
+SignalOutcome run_and_signal(const fs::path& dir, const fs::path& logs, const SignalCase& c,
+                             int signal) {
+  std::vector<std::string> argv_text = {SOFTRAST_CLI_PATH};
+  argv_text.insert(argv_text.end(), c.args.begin(), c.args.end());
+  std::vector<char*> argv;
+  for (std::string& a : argv_text) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::vector<std::string> env_text;
+  for (char** e = environ; *e; ++e) env_text.push_back(*e);
+  env_text.insert(env_text.end(), c.env.begin(), c.env.end());
+  std::vector<char*> envp;
+  for (std::string& e : env_text) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  std::string out = (logs / "stdout").string(), err = (logs / "stderr").string();
+  auto start = std::chrono::steady_clock::now();
+  pid_t pid = ::fork();
+  if (pid == 0) {
+    int o = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    int e = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (o < 0 || e < 0 || ::chdir(dir.c_str()) != 0) ::_exit(126);
+    ::dup2(o, 1);
+    ::dup2(e, 2);
+    ::execve(argv[0], argv.data(), envp.data());
+    ::_exit(127);
+  }
+  SignalOutcome r;
+  std::chrono::steady_clock::time_point sent;
+  int status = 0;
+  rusage usage{};
+  for (;;) {
+    pid_t done = ::wait4(pid, &status, WNOHANG, &usage);
+    auto now = std::chrono::steady_clock::now();
+    r.outcome.seconds = std::chrono::duration<double>(now - start).count();
+    if (done == pid) break;
+    if (!r.signalled && catches(pid, signal) && c.busy(dir)) {
+      ::kill(pid, signal);
+      r.signalled = true;
+      sent = now;
+    }
+    double waited = r.signalled ? std::chrono::duration<double>(now - sent).count() : 0.0;
+    if (!r.outcome.timed_out &&
+        (waited > kSignalSeconds || (!r.signalled && r.outcome.seconds > 120.0))) {
+      r.outcome.timed_out = true;
+      ::kill(pid, SIGKILL);
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  }
+  if (r.signalled) {
+    r.seconds_after_signal =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+  }
+  r.outcome.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.outcome.max_rss_kb = usage.ru_maxrss;
+  r.outcome.err = read_file(err);
+  return r;
+}
+
+std::vector<SignalCase> signal_cases() {
+  std::vector<SignalCase> c;
+  auto running = [](const fs::path&) { return true; };
+  // A long render: 100,000 timed frames of 1024x1024, then out.png.
+  c.push_back({"long render",
+               {{"tri.obj", kTriangleObj}},
+               {"tri.obj", "-q", "--size", "1024x1024", "--frames", "100000", "-o", "out.png"},
+               {},
+               running});
+  // The image being written: a second after each 64 KiB of the TGA (RLE, about 180 KiB).
+  c.push_back({"writing the image",
+               {{"tri.obj", kTriangleObj}},
+               {"tri.obj", "-q", "--size", "1024x1024", "-o", "out.tga"},
+               {"SOFTRAST_TEST_SLOW_WRITE_MS=1000"},
+               [](const fs::path& dir) { return has_temporary_file(dir); }});
+  // A batch of 400 renders of 512x512, interrupted once the first image exists.
+  std::string jobs;
+  for (int i = 0; i < 400; ++i) {
+    jobs += "{\"model\": \"tri.obj\", \"output\": \"out/" + std::to_string(i) +
+            ".png\", \"size\": \"512x512\", \"threads\": 1}\n";
+  }
+  c.push_back({"a batch",
+               {{"tri.obj", kTriangleObj}, {"jobs.jsonl", jobs}},
+               {"batch", "jobs.jsonl", "-q"},
+               {},
+               [](const fs::path& dir) { return fs::exists(dir / "out" / "0.png"); }});
+  return c;
+}
+
+TEST_F(HostileInput, SignalsEndTheProgramCleanly) {
+  for (const SignalCase& c : signal_cases()) {
+    for (int signal : {SIGINT, SIGTERM}) {
+      std::string name = std::string(signal == SIGINT ? "SIGINT" : "SIGTERM") + " during " + c.name;
+      SCOPED_TRACE(name);
+      fs::path work = root_ / "work";
+      fs::remove_all(work);
+      fs::create_directories(work);
+      for (const auto& [file, bytes] : c.files)
+        std::ofstream(work / file, std::ios::binary) << bytes;
+      SignalOutcome r = run_and_signal(work, root_ / "logs", c, signal);
+      ASSERT_TRUE(r.signalled) << "the program ended before it was busy: " << r.outcome.err;
+      EXPECT_FALSE(r.outcome.timed_out)
+          << "still running " << kSignalSeconds << " s after the signal";
+      EXPECT_LT(r.seconds_after_signal, kSignalSeconds);
+      EXPECT_EQ(r.outcome.exit_code, 128 + signal) << "stderr: " << r.outcome.err;
+      ASSERT_EQ(std::count(r.outcome.err.begin(), r.outcome.err.end(), '\n'), 1)
+          << "stderr: " << r.outcome.err;
+      EXPECT_EQ(r.outcome.err.rfind("softrast: error: ", 0), 0u) << r.outcome.err;
+      EXPECT_NE(r.outcome.err.find(signal == SIGINT ? "SIGINT" : "SIGTERM"), std::string::npos)
+          << r.outcome.err;
+      EXPECT_FALSE(has_temporary_file(work)) << "a temporary file is left";
+      EXPECT_FALSE(fs::exists(work / "out.png"));
+      EXPECT_FALSE(fs::exists(work / "out.tga"));
+      // Batch outputs that exist are whole images.
+      if (fs::exists(work / "out")) {
+        int complete = 0;
+        for (const auto& entry : fs::directory_iterator(work / "out")) {
+          Result<Image> image = load_image(entry.path().string());
+          EXPECT_TRUE(image.ok() && image->width == 512)
+              << entry.path() << " is not a complete image";
+          complete += image.ok();
+        }
+        EXPECT_GE(complete, 1);
+        EXPECT_LT(complete, 400) << "the batch was not interrupted";
+      }
+      report_row(name, r.outcome.exit_code, r.outcome.err);
+      std::printf("hostile signal: %s: exit %d after %.2f s, %s", name.c_str(), r.outcome.exit_code,
+                  r.seconds_after_signal, r.outcome.err.c_str());
+    }
+  }
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // apps/softrast/main.cpp: the softrast command line. Exit codes: 0 success, 1 runtime error
 // (files, memory, failed batch jobs), 2 usage error (flags); every error is one line
 // "softrast: error: ..." (here, and in batch, info and sequence through report.hpp). SIGINT and
-// SIGTERM still end it as signals, after removing any temporary image file.
+// SIGTERM still end it as signals, after removing any temporary image file and printing one
+// error line.
 //
 //   softrast [render] [MODEL...] [-o out.png] [flags]     see `softrast --help`
 //   softrast batch JOBS.jsonl [--shard K/N]               see `softrast batch --help`
@@ -10,6 +11,7 @@
 //   softrast help [COMMAND]
 
 #include <signal.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -95,8 +97,16 @@ void describe(CLI::App& app, CLI::App& render) {
 // SIGINT or SIGTERM: remove the temporary file of an image being written, then die of the signal
 // (SA_RESETHAND has restored the default action; the raised signal is delivered when the handler
 // returns), so the exit status still says which signal ended the program. Async-signal-safe.
+// One line on stderr says why the program stopped (write() only: async-signal-safe).
 void on_terminating_signal(int signal) {
   remove_pending_temporary_file();
+  static constexpr char kInterrupt[] =
+      "softrast: error: interrupted by SIGINT; no partial output file is left\n";
+  static constexpr char kTerminate[] =
+      "softrast: error: terminated by SIGTERM; no partial output file is left\n";
+  const char* line = signal == SIGINT ? kInterrupt : kTerminate;
+  size_t size = signal == SIGINT ? sizeof kInterrupt - 1 : sizeof kTerminate - 1;
+  [[maybe_unused]] ssize_t written = write(STDERR_FILENO, line, size);
   raise(signal);
 }
 
