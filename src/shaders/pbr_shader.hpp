@@ -18,29 +18,7 @@ namespace softrast::detail {
 
 // ---- Colour maths, 16 lanes at a time ----------------------------------------------------
 
-// 2^x for x in [-126, 126] (clamped): 2^floor(x) from the exponent bits times a degree-6 Taylor
-// polynomial of 2^f on [0, 1) (relative error below 2e-5, far under one 8-bit step).
-template <int N>
-SOFTRAST_SIMD_INLINE simd::Float<N> fast_exp2(const simd::Float<N>& x) {
-  using F = simd::Float<N>;
-  using I = simd::Int<N>;
-  F xc = simd::clamp(x, F(-126.0f), F(126.0f));
-  I i = simd::to_int(xc);            // truncates towards zero
-  i = i + (simd::to_float(i) > xc);  // the mask is -1 where truncation went up: floor
-  F f = xc - simd::to_float(i);
-  F p = F(1.0f) +
-        f * (F(0.693147181f) +
-             f * (F(0.240226507f) +
-                  f * (F(0.0555041087f) + f * (F(0.00961812911f) +
-                                               f * (F(0.00133335581f) + f * F(0.000154035304f))))));
-  return p * simd::bit_cast_float((i + I(127)) << 23);
-}
-
-// x^e for x > 0 (x is clamped to at least 1e-10).
-template <int N>
-SOFTRAST_SIMD_INLINE simd::Float<N> fast_pow(const simd::Float<N>& x, float e) {
-  return fast_exp2<N>(simd::Float<N>(e) * fast_log2<N>(simd::max(x, simd::Float<N>(1.0e-10f))));
-}
+// fast_exp2, fast_pow and cross are shading_math.hpp's (through builtin_shaders.hpp).
 
 // The sRGB transfer functions (IEC 61966-2-1) per channel. Decoding (textures) is a cubic fit,
 // within 0.0017 of the exact curve (0.43 of an 8-bit step), cheap enough for every map sample;
@@ -80,11 +58,6 @@ SOFTRAST_SIMD_INLINE simd::Vec3<N> tone_map_neutral(const simd::Vec3<N>& in) {
   simd::Int<N> low = peak < F(kStart);
   return {simd::select(low, c.x, out.x), simd::select(low, c.y, out.y),
           simd::select(low, c.z, out.z)};
-}
-
-template <int N>
-SOFTRAST_SIMD_INLINE simd::Vec3<N> cross(const simd::Vec3<N>& a, const simd::Vec3<N>& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 
 template <int N>
