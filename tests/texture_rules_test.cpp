@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <random>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "softrast/renderer.hpp"
 #include "softrast/shader.hpp"
 #include "test_util.hpp"
+#include "texture/srgb_encode.hpp"
 
 namespace softrast {
 namespace {
@@ -296,6 +298,42 @@ Texture level_coded_texture() {
 struct LodBounds {
   double lo, hi;
 };
+
+// The table-driven encoder that builds sRGB mip chains (no pow per texel) gives the formula's byte
+// for every float in [0, 1] tried: a dense sweep over the float bits (every 251st float, about
+// 4.2 million values, denser than any threshold gap) and the floats on both sides of every point
+// where the formula's byte changes.
+TEST(TextureRules, SrgbByteTableEqualsTheFormula) {
+  auto bits_float = [](uint32_t b) {
+    float f;
+    std::memcpy(&f, &b, sizeof f);
+    return f;
+  };
+  uint32_t one;
+  float f1 = 1.0f;
+  std::memcpy(&one, &f1, sizeof one);
+  int mismatches = 0, changes = 0;
+  uint8_t previous = linear_to_srgb_byte_exact(0.0f);
+  for (uint32_t b = 0; b <= one; b += 251) {
+    float c = bits_float(b);
+    uint8_t exact = linear_to_srgb_byte_exact(c);
+    if (linear_to_srgb_byte(c) != exact) ++mismatches;
+    if (exact != previous) {
+      // The change happened in (b - 251, b]: check every float there.
+      ++changes;
+      for (uint32_t k = b - 251; k <= b; ++k) {
+        float d = bits_float(k);
+        if (linear_to_srgb_byte(d) != linear_to_srgb_byte_exact(d)) ++mismatches;
+      }
+      previous = exact;
+    }
+  }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_EQ(changes, 255);  // every byte value is reached, in order
+  for (float c : {-1.0f, -0.0f, 1.5f, INFINITY, NAN}) {
+    EXPECT_EQ(linear_to_srgb_byte(c), linear_to_srgb_byte_exact(c)) << c;
+  }
+}
 
 TEST(TextureRules, MipLevelOnARecedingPlaneIsWithinTheLodBounds) {
   constexpr int kW = 256, kH = 192;

@@ -453,8 +453,11 @@ inline void gather_pair(const int32_t* base, const Native<4>::I& index, Native<4
 [[gnu::target("avx512f")]] inline void gather_pair(const int32_t* base, const Native<16>::I& index,
                                                    Native<16>::I& lo, Native<16>::I& hi) {
   __m512i i = __m512i(index);
-  __m512i a = _mm512_i32gather_epi64(_mm512_castsi512_si256(i), base, 4);        // lanes 0..7
-  __m512i c = _mm512_i32gather_epi64(_mm512_extracti64x4_epi64(i, 1), base, 4);  // lanes 8..15
+  // The masked form with a zero source: the same loads, and GCC 12's header does not leave the
+  // unmasked form's source uninitialised (a -Wmaybe-uninitialized warning per use).
+  const __m512i zero = _mm512_setzero_si512();
+  __m512i a = _mm512_mask_i32gather_epi64(zero, 0xff, _mm512_castsi512_si256(i), base, 4);
+  __m512i c = _mm512_mask_i32gather_epi64(zero, 0xff, _mm512_extracti64x4_epi64(i, 1), base, 4);
   const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
   const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
   lo = Native<16>::I(_mm512_permutex2var_epi32(a, even, c));

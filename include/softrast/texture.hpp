@@ -3,10 +3,12 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -71,8 +73,14 @@ inline float fast_log2(float x) {
 class Texture {
  public:
   Texture() = default;
+  Texture(const Texture& other);
+  Texture& operator=(const Texture& other);
+  Texture(Texture&&) noexcept = default;
+  Texture& operator=(Texture&&) noexcept = default;
   // Takes an image as stored in a file (top row first) and flips it so that v = 0 is its bottom.
-  // `space` says how the bytes encode colour; kSrgb builds the mip chain in linear space.
+  // `space` says how the bytes encode colour; kSrgb builds the mip chain in linear space. The
+  // levels past the base are built when first read (level(k) for k > 0, or trilinear sampling),
+  // so a texture that is only ever sampled at its base level never pays for them.
   static Texture from_image(const Image& image, ColorSpace space = ColorSpace::kLinear);
   // A texture whose mip chain is given, not built: levels[k] is level k as stored in a file and
   // must be max(width >> k, 1) x max(height >> k, 1), down to 1x1 (else it aborts: a contract).
@@ -108,6 +116,7 @@ class Texture {
   // derivative vectors in texels of the base level).
   glm::vec4 sample(const Sampler& s, glm::vec2 uv, glm::vec2 duv_dx, glm::vec2 duv_dy) const {
     if (texels_.empty() || s.filter != Filter::kTrilinear) return sample(s, uv);
+    ensure_mips();
     float lod = level_of_detail(duv_dx, duv_dy);
     if (!(lod > 0.0f)) return sample_bilinear(s, uv, 0);  // magnification (and NaN)
     float top = float(levels() - 1);
@@ -127,9 +136,16 @@ class Texture {
   }
 
   // The mip chain: level 0 is the image, each next level half the size (rounded down, at least
-  // 1), down to 1x1; built once by 2x2 box filtering.
+  // 1), down to 1x1; built once by 2x2 box filtering, on first use.
   int levels() const { return int(levels_.size()); }
-  const MipLevel& level(int k) const { return levels_[size_t(k)]; }
+  const MipLevel& level(int k) const {
+    if (k > 0) ensure_mips();
+    return levels_[size_t(k)];
+  }
+  // Builds levels 1 and up unless they are built (safe to call from several threads at once).
+  void ensure_mips() const {
+    if (mips_ && !mips_->ready.load(std::memory_order_acquire)) build_mips();
+  }
 
   // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
   static int wrap(Wrap mode, int i, int size);
@@ -147,6 +163,11 @@ class Texture {
     return {t[0] * k, t[1] * k, t[2] * k, t[3] * k};
   }
 
+  struct MipState {
+    std::mutex mutex;
+    std::atomic<bool> ready{false};
+  };
+  void build_mips() const;
   static std::vector<MipLevel> mip_levels(int width, int height);
   void downsample(const MipLevel& from, const MipLevel& to);
   void downsample_srgb(const MipLevel& from, const MipLevel& to);
@@ -154,8 +175,11 @@ class Texture {
   ColorSpace space_ = ColorSpace::kLinear;
   int width_ = 0;
   int height_ = 0;
-  std::vector<uint8_t> texels_;  // every level, rows bottom-up, RGBA8
+  // Every level, rows bottom-up, RGBA8; sized for the whole chain from the start (levels past
+  // the base are written once, by build_mips, under mips_->mutex).
+  mutable std::vector<uint8_t> texels_;
   std::vector<MipLevel> levels_;
+  std::unique_ptr<MipState> mips_;  // null for an empty or moved-from texture
 };
 
 // Wraps texel index i into [0, size) by the OpenGL rules for each mode.

@@ -172,6 +172,18 @@ class Placer {
     }
     return image_.pixel(x, y);
   }
+  // For rows stored left to right: the next min(count, rest of the row) destinations, which are
+  // consecutive in the image; `n` says how many.
+  uint8_t* row_run(int64_t count, int& n) {
+    n = int(std::min<int64_t>(count, h_.width - column_));
+    uint8_t* first = image_.pixel(column_, h_.top_down ? row_ : h_.height - 1 - row_);
+    column_ += n;
+    if (column_ == h_.width) {
+      column_ = 0;
+      ++row_;
+    }
+    return first;
+  }
 
  private:
   Image& image_;
@@ -207,6 +219,25 @@ class Decoder {
   Status copy_pixels(int64_t count) {
     const int64_t bytes = format_.header.pixel_bytes();
     if (end_ - at_ < count * bytes) return truncated();
+    const Header& h = format_.header;
+    if (h.kind == kTrueColour && (h.bits == 24 || h.bits == 32) && !h.right_to_left) {
+      // The usual texture: BGR(A) rows left to right, converted a row's run at a time.
+      while (count > 0) {
+        int n;
+        uint8_t* out = placer_.row_run(count, n);
+        if (h.bits == 24) {
+          for (int i = 0; i < n; ++i, out += 4, at_ += 3) {
+            out[0] = at_[2], out[1] = at_[1], out[2] = at_[0], out[3] = 255;
+          }
+        } else {
+          for (int i = 0; i < n; ++i, out += 4, at_ += 4) {
+            out[0] = at_[2], out[1] = at_[1], out[2] = at_[0], out[3] = at_[3];
+          }
+        }
+        count -= n;
+      }
+      return {};
+    }
     for (int64_t i = 0; i < count; ++i, at_ += bytes) {
       if (!format_.to_rgba(at_, placer_.next())) return bad_index();
     }

@@ -210,6 +210,26 @@ struct BlockTarget {
       resolve_lanes<kMode == Mode::kLessEqual>(depth, x, y, bits, v.depth[b], v.id[b]);
     }
   }
+  // A whole 16x16 area at (x, y), inside the triangle and the tile's region, into the depth
+  // resolve (deferred modes only): its 16 blocks in a row, the loads of their depth checked four
+  // at a time (the four blocks of a row of the area are four consecutive bits of `touched`).
+  [[gnu::always_inline]] void inside_mid_block(int x, int y) {
+    static_assert(kMidBlockSize == 4 * kBlockSize && TileVisibility::kBlocksPerRow % 4 == 0);
+    TileVisibility& v = *job.visibility;
+    for (int j = 0; j < 4; ++j) {
+      int row_y = y + kBlockSize * j;
+      int b = v.block_index(x, row_y);
+      uint32_t missing = ~uint32_t(v.touched[b >> 6] >> (b & 63)) & 0xfu;
+      for (; missing != 0; missing &= missing - 1) {
+        int i = __builtin_ctz(missing);
+        load_depth(v, b + i, x + kBlockSize * i, row_y);
+      }
+      for (int i = 0; i < 4; ++i) {
+        resolve_lanes<kMode == Mode::kLessEqual>(depth, x + kBlockSize * i, row_y, 0xffffu,
+                                                 v.depth[b + i], v.id[b + i]);
+      }
+    }
+  }
 };
 
 // Exact block classification against the three edges, as tile_raster.cpp's: E is linear, so its
@@ -281,6 +301,14 @@ template <Mode kMode, class V, class T>
       grid.at(mx, my, e);
       Test test = classify(e, mid);
       if (test == Test::kOutside) continue;
+      if constexpr (kMode != Mode::kImmediate) {
+        // The usual case of large triangles: the whole area inside, no edge or region cuts it.
+        if (test == Test::kInside && mx >= bx0 && my >= by0 && mx + kMidBlockSize <= area.x1 &&
+            my + kMidBlockSize <= area.y1) {
+          emit.inside_mid_block(mx, my);
+          continue;
+        }
+      }
       // Only blocks that overlap the area (the 32-bit bound in fixed_point.hpp relies on it).
       int y_end = std::min(my + kMidBlockSize, area.y1),
           x_end = std::min(mx + kMidBlockSize, area.x1);

@@ -56,18 +56,34 @@ Surface surface_of(const Mesh& mesh, int material, const RenderOptions& opt) {
   return s;
 }
 
-// Whether a texture has texels that are not opaque, judged from its smallest level of at
-// least 64x64 texels (or the base level; a few thousand texels at most): a box-filtered level
-// keeps any translucent area of more than a few base texels below 250.
+// Whether a texture has texels that are not opaque, judged by squares of its base level: the
+// mean alpha of each square of 2^L x 2^L texels, where level L is the smallest level of at least
+// 64x64 texels (or the base), so that a translucent area of more than a few texels counts and a
+// stray texel does not. Reads only the base level (the mip chain is built when first sampled).
 bool has_translucent_texels(const Texture& t) {
+  const int w = t.width(), h = t.height();
+  const auto* texels = reinterpret_cast<const uint32_t*>(t.texels());
+  uint32_t lowest = 255;
+  for (size_t k = 0; k < size_t(w) * size_t(h); ++k) lowest = std::min(lowest, texels[k] >> 24);
+  if (lowest >= 250) return false;  // the usual opaque map: one pass over the alpha
   int level = 0;
-  while (level + 1 < t.levels() && t.level(level + 1).width * t.level(level + 1).height >= 4096) {
+  auto side = [](int n, int l) { return std::max(n >> l, 1); };
+  while ((side(w, level) > 1 || side(h, level) > 1) &&
+         side(w, level + 1) * side(h, level + 1) >= 4096) {
     ++level;
   }
-  const MipLevel& l = t.level(level);
-  const uint8_t* texels = t.texels() + l.offset * 4;
-  for (size_t k = 0; k < size_t(l.width) * size_t(l.height); ++k) {
-    if (texels[k * 4 + 3] < 250) return true;
+  const int block = 1 << level;
+  for (int by = 0; by < h; by += block) {
+    for (int bx = 0; bx < w; bx += block) {
+      uint64_t sum = 0, count = 0;
+      for (int y = by; y < std::min(h, by + block); ++y) {
+        for (int x = bx; x < std::min(w, bx + block); ++x) {
+          sum += texels[size_t(y) * size_t(w) + size_t(x)] >> 24;
+          ++count;
+        }
+      }
+      if (sum < 250 * count) return true;
+    }
   }
   return false;
 }

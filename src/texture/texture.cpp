@@ -6,8 +6,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 #include "softrast/texture.hpp"
+#include "texture/srgb_encode.hpp"
 
 namespace softrast {
 
@@ -19,6 +21,72 @@ float linear_to_srgb(float c) {
   if (!(c > 0.0f)) return 0.0f;
   if (c >= 1.0f) return 1.0f;
   return c <= 0.0031308f ? c * 12.92f : float(1.055 * std::pow(double(c), 1.0 / 2.4) - 0.055);
+}
+
+uint8_t linear_to_srgb_byte_exact(float c) {
+  return uint8_t(linear_to_srgb(c) * 255.0f + 0.5f);
+}
+
+namespace {
+
+uint32_t float_bits(float f) {
+  uint32_t b;
+  std::memcpy(&b, &f, sizeof b);
+  return b;
+}
+float bits_float(uint32_t b) {
+  float f;
+  std::memcpy(&f, &b, sizeof f);
+  return f;
+}
+
+// linear_to_srgb_byte without pow: the byte is a non-decreasing function of c, so it is the
+// number of thresholds at or below c, where threshold k (1..255) is the smallest float in (0, 1]
+// whose byte is k or more (found by bisection over the bits of positive floats, which order as
+// the floats do). A table over 4096 equal steps of c gives the byte at each step's start, so a
+// lookup walks at most a few thresholds. Built once, with about 8,000 pow calls.
+struct SrgbEncoder {
+  static constexpr int kSteps = 4096;
+  std::array<float, 257> threshold{};  // [0] unused; [256] = +inf
+  std::array<uint8_t, kSteps + 1> start{};
+
+  SrgbEncoder() {
+    const uint32_t one = float_bits(1.0f);
+    for (int k = 1; k < 256; ++k) {
+      uint32_t lo = 0, hi = one;  // byte(bits lo) < k <= byte(bits hi)
+      while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (linear_to_srgb_byte_exact(bits_float(mid)) >= k) {
+          hi = mid;
+        } else {
+          lo = mid;
+        }
+      }
+      threshold[size_t(k)] = bits_float(hi);
+    }
+    threshold[256] = INFINITY;
+    for (int s = 0; s <= kSteps; ++s) start[size_t(s)] = slow(float(s) / float(kSteps));
+  }
+  uint8_t slow(float c) const {
+    int k = 0;
+    while (k < 255 && c >= threshold[size_t(k) + 1]) ++k;
+    return uint8_t(k);
+  }
+  uint8_t operator()(float c) const {
+    if (!(c > 0.0f)) return 0;
+    if (c >= 1.0f) return 255;
+    // Truncation of c * kSteps cannot pass c: start[s] is the byte at s / kSteps <= c.
+    int k = start[size_t(c * float(kSteps))];
+    while (k < 255 && c >= threshold[size_t(k) + 1]) ++k;
+    return uint8_t(k);
+  }
+};
+
+}  // namespace
+
+uint8_t linear_to_srgb_byte(float c) {
+  static const SrgbEncoder encoder;
+  return encoder(c);
 }
 
 const float* srgb_decode_table() {
@@ -51,14 +119,42 @@ Texture Texture::from_image(const Image& image, ColorSpace space) {
     const uint8_t* source = image.pixel(0, image.height - 1 - j);
     std::copy(source, source + row_bytes, texture.texels_.begin() + row_bytes * size_t(j));
   }
-  for (size_t k = 1; k < texture.levels_.size(); ++k) {
-    if (space == ColorSpace::kSrgb) {
-      texture.downsample_srgb(texture.levels_[k - 1], texture.levels_[k]);
+  texture.mips_ = std::make_unique<MipState>();
+  return texture;
+}
+
+void Texture::build_mips() const {
+  std::lock_guard<std::mutex> lock(mips_->mutex);
+  if (mips_->ready.load(std::memory_order_relaxed)) return;
+  auto* self = const_cast<Texture*>(this);  // only the levels past the base are written
+  for (size_t k = 1; k < levels_.size(); ++k) {
+    if (space_ == ColorSpace::kSrgb) {
+      self->downsample_srgb(levels_[k - 1], levels_[k]);
     } else {
-      texture.downsample(texture.levels_[k - 1], texture.levels_[k]);
+      self->downsample(levels_[k - 1], levels_[k]);
     }
   }
-  return texture;
+  mips_->ready.store(true, std::memory_order_release);
+}
+
+Texture::Texture(const Texture& other) {
+  *this = other;
+}
+
+Texture& Texture::operator=(const Texture& other) {
+  if (this == &other) return *this;
+  other.ensure_mips();
+  space_ = other.space_;
+  width_ = other.width_;
+  height_ = other.height_;
+  texels_ = other.texels_;
+  levels_ = other.levels_;
+  mips_.reset();
+  if (other.mips_) {
+    mips_ = std::make_unique<MipState>();
+    mips_->ready.store(true, std::memory_order_relaxed);
+  }
+  return *this;
 }
 
 Texture Texture::from_mip_levels(const std::vector<Image>& levels, ColorSpace space) {
@@ -83,6 +179,7 @@ Texture Texture::from_mip_levels(const std::vector<Image>& levels, ColorSpace sp
       std::copy(source, source + row_bytes, texture.texels_.begin() + l.offset * 4 + row_bytes * j);
     }
   }
+  texture.mips_->ready.store(true, std::memory_order_relaxed);  // given, not built
   return texture;
 }
 
@@ -119,6 +216,7 @@ void Texture::downsample(const MipLevel& from, const MipLevel& to) {
 // minified colour textures (the mean of 0 and 255 is 128, which decodes to 0.22, not 0.5).
 void Texture::downsample_srgb(const MipLevel& from, const MipLevel& to) {
   const float* decode = srgb_decode_table();
+  static const SrgbEncoder encode;
   for (int j = 0; j < to.height; ++j) {
     int j0 = std::min(2 * j, from.height - 1), j1 = std::min(2 * j + 1, from.height - 1);
     for (int i = 0; i < to.width; ++i) {
@@ -130,7 +228,7 @@ void Texture::downsample_srgb(const MipLevel& from, const MipLevel& to) {
       uint8_t* out = &texels_[(to.offset + size_t(j) * to.width + i) * 4];
       for (int ch = 0; ch < 3; ++ch) {
         float mean = 0.25f * (decode[a[ch]] + decode[b[ch]] + decode[c[ch]] + decode[d[ch]]);
-        out[ch] = uint8_t(linear_to_srgb(mean) * 255.0f + 0.5f);
+        out[ch] = encode(mean);  // linear_to_srgb_byte(mean), without the call
       }
       out[3] = uint8_t((a[3] + b[3] + c[3] + d[3] + 2) / 4);
     }
