@@ -27,8 +27,9 @@ struct CheckerHole {
     return mvp * glm::vec4(positions[i], 1.0f);
   }
 
+  // SOFTRAST_SIMD_INLINE: compiled inside each SIMD level's block function (see shader.hpp).
   template <int N>
-  void shade(softrast::Fragments<N>& f) const {
+  SOFTRAST_SIMD_INLINE void shade(softrast::Fragments<N>& f) const {
     using F = softrast::simd::Float<N>;
     using I = softrast::simd::Int<N>;
     F du = f.varying(0) - 0.5f, dv = f.varying(1) - 0.5f;

@@ -5,11 +5,14 @@
 //   static constexpr int kVaryings = N;               // 0..16 floats from vertex to fragment
 //   glm::vec4 vertex(uint32_t index, float* varyings) const;   // clip-space position; writes N
 // and a fragment shader, in one of two forms:
-//   template <int N> void shade(Fragments<N>& f) const;  // wide: a 4x4 block at once (fast)
+//   template <int N> SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const;  // wide: 4x4 at once
 //   bool fragment(FragmentInput& in, glm::vec4& color) const;  // scalar: one pixel, false discards
 // The wide form is written with softrast::simd types (simd.hpp) as if for one pixel: f.vec3(0)
 // is a varying for all 16 pixels, f.color the output; it is compiled for SSE2, SSE4, AVX2 and
-// AVX-512 and the widest the CPU has runs. Optional traits:
+// AVX-512 and the widest the CPU has runs. Declare it SOFTRAST_SIMD_INLINE (always inline): GCC
+// can otherwise compile it once, for the baseline x86-64, and call that copy from every level's
+// block function (its wide operations then run as SSE2 code that calls out for every operation, which
+// made the built-in Gouraud shading several times slower). Optional traits:
 //   static constexpr bool kWritesDepth = true;  // the shader sets the depth: late depth test
 //   static constexpr bool kDiscards = true;     // a wide shader that calls f.discard()
 // A wide shader that neither writes depth nor discards lets opaque depth-tested draws resolve

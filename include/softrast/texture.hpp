@@ -9,6 +9,7 @@
 #include <cstring>
 #include <memory>
 #include <mutex>
+#include <utility>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -163,6 +164,26 @@ class Texture {
     return {t[0] * k, t[1] * k, t[2] * k, t[3] * k};
   }
 
+  // Leaves new elements uninitialised: the levels past the base are written when built, and
+  // until then their pages are never touched (no zero-filling of memory that may never be used).
+  template <class T>
+  struct NoInitAllocator : std::allocator<T> {
+    template <class U>
+    struct rebind {
+      using other = NoInitAllocator<U>;
+    };
+    NoInitAllocator() = default;
+    template <class U>
+    NoInitAllocator(const NoInitAllocator<U>&) noexcept {}
+    template <class U>
+    void construct(U* p) noexcept {
+      ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+      ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+  };
   struct MipState {
     std::mutex mutex;
     std::atomic<bool> ready{false};
@@ -177,7 +198,7 @@ class Texture {
   int height_ = 0;
   // Every level, rows bottom-up, RGBA8; sized for the whole chain from the start (levels past
   // the base are written once, by build_mips, under mips_->mutex).
-  mutable std::vector<uint8_t> texels_;
+  mutable std::vector<uint8_t, NoInitAllocator<uint8_t>> texels_;
   std::vector<MipLevel> levels_;
   std::unique_ptr<MipState> mips_;  // null for an empty or moved-from texture
 };

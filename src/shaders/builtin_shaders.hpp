@@ -64,7 +64,7 @@ struct FlatShader {
   bool srgb = false;  // encode the output (the linear workflow)
   glm::vec4 vertex(uint32_t i, float*) const { return in.clip(i); }
   template <int N>
-  void shade(Fragments<N>& f) const {
+  SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     f.color = {color.r, color.g, color.b, color.a};
     if (srgb) f.color = encode_srgb<N>(f.color);
   }
@@ -94,7 +94,7 @@ struct GouraudShader {
     return in.clip(i);
   }
   template <int N>
-  void shade(Fragments<N>& f) const {
+  SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     int first = kTwoSided && !f.front_facing ? 3 : 0;
     f.color = {f.varying(first), f.varying(first + 1), f.varying(first + 2), alpha};
     if (lighting.srgb_output) f.color = encode_srgb<N>(f.color);
@@ -113,7 +113,7 @@ struct TextureShader {
     return in.clip(i);
   }
   template <int N>
-  void shade(Fragments<N>& f) const {
+  SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     simd::Vec4<N> t = sample_with_derivatives(*texture, sampler, f, 0);
     f.color = {t.x, t.y, t.z, t.w * alpha};
     if (srgb) f.color = encode_srgb<N>(f.color);
@@ -178,7 +178,7 @@ struct PhongShader {
     return n;
   }
   template <int N>
-  void shade(Fragments<N>& f) const {
+  SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     using F = simd::Float<N>;
     simd::Vec3<N> n = normal(f);
     simd::Vec3<N> p = f.vec3(0);
@@ -214,7 +214,7 @@ struct NormalsShader {
     return in.clip(i);
   }
   template <int N>
-  void shade(Fragments<N>& f) const {
+  SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     simd::Vec3<N> n = simd::normalize(f.vec3(0)) * simd::Float<N>(0.5f) + simd::Float<N>(0.5f);
     f.color = {n.x, n.y, n.z, simd::Float<N>(1.0f)};
   }

@@ -192,7 +192,7 @@ struct PbrShader {
   }
 
   template <int N>
-  void shade(Fragments<N>& f) const {
+  SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     using F = simd::Float<N>;
     using V3 = simd::Vec3<N>;
     const PbrMaterial& mat = *material;
