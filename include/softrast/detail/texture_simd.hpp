@@ -8,6 +8,7 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 
+#include <cstddef>
 #include <cstring>
 
 #include "softrast/simd.hpp"
@@ -138,16 +139,21 @@ SOFTRAST_SIMD_INLINE simd::Float<N> fast_log2(const simd::Float<N>& x) {
   return exponent + p;
 }
 
-// The mip level sizes and offsets of each lane's level `l` (0 <= l < levels).
+// The mip level sizes and offsets of each lane's level `l` (0 <= l < levels), gathered from the
+// texture's level table (MipLevel is {int width, int height, size_t offset}: 16 bytes, the
+// offset's low 32 bits first on x86, and offsets stay below 2^31 texels). The caller has built
+// the chain (Texture::ensure_mips).
 template <int N>
 SOFTRAST_SIMD_INLINE void level_lanes(const Texture& t, const simd::Int<N>& l, simd::Int<N>& w,
                                       simd::Int<N>& h, simd::Int<N>& offset) {
-  for (int lane = 0; lane < simd::kLanes; ++lane) {
-    const MipLevel& m = t.level(l.lane(lane));
-    w.p[lane / N][lane % N] = m.width;
-    h.p[lane / N][lane % N] = m.height;
-    offset.p[lane / N][lane % N] = int32_t(m.offset);
-  }
+  static_assert(sizeof(MipLevel) == 16 && offsetof(MipLevel, height) == 4 &&
+                offsetof(MipLevel, offset) == 8);
+  using I = simd::Int<N>;
+  const auto* table = reinterpret_cast<const int32_t*>(&t.level(0));
+  I at = l * I(4);
+  w = simd::gather<N>(table, at);
+  h = simd::gather<N>(table, at + I(1));
+  offset = simd::gather<N>(table, at + I(2));
 }
 
 }  // namespace detail
@@ -189,10 +195,15 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler&
   // Halving a power of two (down to 1) keeps it one, so the base level decides for every level.
   int tw = texture.width(), th = texture.height();
   bool pow2_u = (tw & (tw - 1)) == 0, pow2_v = (th & (th - 1)) == 0;
-  I w0, h0, o0, w1, h1, o1;
+  texture.ensure_mips();
+  I w0, h0, o0;
   detail::level_lanes<N>(texture, l0, w0, h0, o0);
-  detail::level_lanes<N>(texture, l1, w1, h1, o1);
   simd::Vec4<N> c0 = detail::sample_level<N>(texture, s, uv, w0, h0, o0, pow2_u, pow2_v, false);
+  // No lane between levels (all magnified, or all at the top level): the second level's weight
+  // is 0 everywhere, and c0 * 1 + c1 * 0 is c0 exactly (texels are finite), so skip it.
+  if (!simd::any(t > F(0.0f))) return c0;
+  I w1, h1, o1;
+  detail::level_lanes<N>(texture, l1, w1, h1, o1);
   simd::Vec4<N> c1 = detail::sample_level<N>(texture, s, uv, w1, h1, o1, pow2_u, pow2_v, false);
   return detail::lerp<N>(c0, c1, t);
 }
