@@ -26,7 +26,9 @@
 namespace softrast {
 
 // What a wide fragment shader sees of one 4x4 block, and what it writes. Lane i is the pixel
-// (x0 + i % 4, y0 + i / 4).
+// (x0 + i % 4, y0 + i / 4). Every member function is always inlined: a wide shader is inlined
+// into each SIMD level's block function, and an out-of-line copy compiled for baseline x86-64
+// would pass and return its 16-lane values in a different ABI (a crash at -O0).
 template <int N>
 struct Fragments {
   using F = simd::Float<N>;
@@ -37,22 +39,22 @@ struct Fragments {
   const F* varyings = nullptr;  // the shader's kVaryings values, perspective-correct
   simd::Vec4<N> color;          // the output, set by the shader
 
-  F varying(int i) const { return varyings[i]; }
-  simd::Vec2<N> vec2(int i) const { return {varyings[i], varyings[i + 1]}; }
-  simd::Vec3<N> vec3(int i) const { return {varyings[i], varyings[i + 1], varyings[i + 2]}; }
-  simd::Vec4<N> vec4(int i) const {
+  SOFTRAST_SIMD_INLINE F varying(int i) const { return varyings[i]; }
+  SOFTRAST_SIMD_INLINE simd::Vec2<N> vec2(int i) const { return {varyings[i], varyings[i + 1]}; }
+  SOFTRAST_SIMD_INLINE simd::Vec3<N> vec3(int i) const { return {varyings[i], varyings[i + 1], varyings[i + 2]}; }
+  SOFTRAST_SIMD_INLINE simd::Vec4<N> vec4(int i) const {
     return {varyings[i], varyings[i + 1], varyings[i + 2], varyings[i + 3]};
   }
   // Change of a value to the next pixel right (ddx) or down (ddy), the same for the four pixels of
   // each 2x2 quad (coarse derivatives, as D3D's ddx_coarse).
-  F ddx(const F& v) const { return quad_difference(v, 1); }
-  F ddy(const F& v) const { return quad_difference(v, 4); }
+  SOFTRAST_SIMD_INLINE F ddx(const F& v) const { return quad_difference(v, 1); }
+  SOFTRAST_SIMD_INLINE F ddy(const F& v) const { return quad_difference(v, 4); }
   // Drops lanes (mask lanes -1) from the output; only for shaders declaring kDiscards = true.
-  void discard(const simd::Int<N>& lanes) { live = live & ~lanes; }
+  SOFTRAST_SIMD_INLINE void discard(const simd::Int<N>& lanes) { live = live & ~lanes; }
 
  private:
   // v at the quad's pixel `step` lanes after its top-left one, minus v at the top-left one.
-  static F quad_difference(const F& v, int step) {
+  SOFTRAST_SIMD_INLINE static F quad_difference(const F& v, int step) {
     float in[simd::kLanes], out[simd::kLanes];
     v.store(in);
     for (int i = 0; i < simd::kLanes; ++i) {
