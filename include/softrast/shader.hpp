@@ -11,9 +11,9 @@
 // is a varying for all 16 pixels, f.color the output; it is compiled for SSE2, SSE4, AVX2 and
 // AVX-512 and the widest the CPU has runs. Declare it SOFTRAST_SIMD_INLINE (always inline): GCC
 // can otherwise compile it once, for the baseline x86-64, and call that copy from every level's
-// block function (its wide operations then run as SSE2 code that calls out for every operation, which
-// made the built-in Gouraud shading several times slower). Functions it calls with wide values
-// must then be always inline too (SOFTRAST_SIMD_INLINE, as every softrast::simd function and
+// block function (its wide operations then run as SSE2 code that calls out for every operation,
+// which made the built-in Gouraud shading several times slower). Functions it calls with wide
+// values must then be always inline too (SOFTRAST_SIMD_INLINE, as every softrast::simd function and
 // Fragments member is), or take and return them by reference: an out-of-line function is
 // compiled for the baseline, whose ABI for 8- and 16-lane values differs. Optional traits:
 //   static constexpr bool kWritesDepth = true;  // the shader sets the depth: late depth test

@@ -9,8 +9,8 @@
 #include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
 
-#include "shaders/shadow_map.hpp"
 #include "shaders/shading_math.hpp"
+#include "shaders/shadow_map.hpp"
 #include "softrast/mesh.hpp"
 #include "softrast/shader.hpp"
 #include "softrast/texture.hpp"

@@ -41,7 +41,9 @@ struct Fragments {
 
   SOFTRAST_SIMD_INLINE F varying(int i) const { return varyings[i]; }
   SOFTRAST_SIMD_INLINE simd::Vec2<N> vec2(int i) const { return {varyings[i], varyings[i + 1]}; }
-  SOFTRAST_SIMD_INLINE simd::Vec3<N> vec3(int i) const { return {varyings[i], varyings[i + 1], varyings[i + 2]}; }
+  SOFTRAST_SIMD_INLINE simd::Vec3<N> vec3(int i) const {
+    return {varyings[i], varyings[i + 1], varyings[i + 2]};
+  }
   SOFTRAST_SIMD_INLINE simd::Vec4<N> vec4(int i) const {
     return {varyings[i], varyings[i + 1], varyings[i + 2], varyings[i + 3]};
   }
