@@ -81,7 +81,7 @@ TEST(VertexKernel, EqualsTheScalarFrontEnd) {
               << simd_level_name(SimdLevel(level)) << " vertex " << i << " size " << size;
           if (codes[i] != 0) continue;
           detail::WindowVertex w = geometry.window_vertex(i);
-          detail::PackedVertex expected{w.x, w.y, w.z, w.inv_w};
+          detail::PackedVertex expected{w.x, w.y, w.z, w.inv_w, w.x_residual, w.y_residual};
           ASSERT_EQ(std::memcmp(&window[i], &expected, sizeof(expected)), 0)
               << simd_level_name(SimdLevel(level)) << " vertex " << i << " size " << size
               << " bias " << bias << ": " << window[i].x << "," << window[i].y << "," << window[i].z

@@ -9,10 +9,13 @@ namespace {
 
 // Round half to even (the default floating-point rounding mode), clamped into the fixed-point
 // range as a last line of defence against values the clipper let through by rounding.
-int32_t snap(double window_coord) {
-  double fx = std::nearbyint(window_coord * kSubpixelOne);
+int32_t snap(double window_coord, float& residual) {
+  double scaled = window_coord * kSubpixelOne;
+  double fx = std::nearbyint(scaled);
   double limit = double(kMaxCoordFx8 - 1);
+  residual = 0.0f;
   if (std::isnan(fx)) return 0;  // unreachable after clipping; never convert NaN to int
+  if (std::abs(fx) <= limit) residual = float(scaled - fx);  // exact in double
   return int32_t(std::clamp(fx, -limit, limit));
 }
 
@@ -30,8 +33,8 @@ WindowVertex Viewport::to_window(const float* v) const {
   double inv_w = 1.0 / double(v[3]);
   double x_ndc = v[0] * inv_w, y_ndc = v[1] * inv_w, z_ndc = v[2] * inv_w;
   WindowVertex out;
-  out.x = snap((x_ndc + 1.0) * 0.5 * width);
-  out.y = snap((1.0 - y_ndc) * 0.5 * height);  // y_ndc = +1 is the top row
+  out.x = snap((x_ndc + 1.0) * 0.5 * width, out.x_residual);
+  out.y = snap((1.0 - y_ndc) * 0.5 * height, out.y_residual);  // y_ndc = +1 is the top row
   out.z = float(std::clamp((z_ndc + 1.0) * 0.5, 0.0, 1.0));
   out.inv_w = float(inv_w);
   out.varyings = v + 4;

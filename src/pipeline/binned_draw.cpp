@@ -149,7 +149,7 @@ class BinnedDraw {
 
   WindowVertex window_vertex(uint32_t i) const {
     const PackedVertex& p = cache_.window[i];
-    return {p.x, p.y, p.z, p.inv_w, geometry_.varyings(i)};
+    return {p.x, p.y, p.z, p.inv_w, geometry_.varyings(i), p.x_residual, p.y_residual};
   }
 
   // Phase 1 for one chunk.

@@ -28,11 +28,16 @@ typedef int64_t Q __attribute__((vector_size(8 * kD)));
   return (v < lo_v) ? lo_v : upper;
 }
 
-// viewport.cpp's snap(): nearbyint(c * 256), NaN to 0, clamped to the fixed-point range.
-[[gnu::always_inline]] inline Q snap(D window_coord) {
-  D fx = round_current(window_coord * double(kSubpixelOne));
+// viewport.cpp's snap(): nearbyint(c * 256), NaN to 0, clamped to the fixed-point range; the
+// residual c * 256 - nearbyint(c * 256) where not clamped (else 0).
+[[gnu::always_inline]] inline Q snap(D window_coord, D& residual) {
+  D scaled = window_coord * double(kSubpixelOne);
+  D fx = round_current(scaled);
   fx = (fx == fx) ? fx : D{};
   double limit = double(kMaxCoordFx8 - 1);
+  D magnitude = (fx < 0.0) ? -fx : fx;
+  residual = (magnitude <= limit) ? scaled - fx : D{};
+  residual = (residual == residual) ? residual : D{};
   return __builtin_convertvector(clamp_like_std(fx, -limit, limit), Q);
 }
 
@@ -55,15 +60,17 @@ void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
     // viewport.cpp: Viewport::to_window.
     D inv_w = 1.0 / w;
     D x_ndc = x * inv_w, y_ndc = y * inv_w, z_ndc = z * inv_w;
-    Q wx = snap((x_ndc + 1.0) * 0.5 * width);
-    Q wy = snap((1.0 - y_ndc) * 0.5 * height);
+    D rx, ry;
+    Q wx = snap((x_ndc + 1.0) * 0.5 * width, rx);
+    Q wy = snap((1.0 - y_ndc) * 0.5 * height, ry);
     D wz = clamp_like_std((z_ndc + 1.0) * 0.5, 0.0, 1.0);
     for (size_t l = 0; l < lanes; ++l) {
       b.codes[i + l] = uint8_t(code[l]);
       float zf = float(wz[l]);
       // geometry_stage.hpp: the depth bias, in float.
       if (b.depth_bias != 0.0f) zf = std::clamp(zf + b.depth_bias, 0.0f, 1.0f);
-      b.window[i + l] = {int32_t(wx[l]), int32_t(wy[l]), zf, float(inv_w[l])};
+      b.window[i + l] = {int32_t(wx[l]), int32_t(wy[l]), zf, float(inv_w[l]), float(rx[l]),
+                         float(ry[l])};
     }
   }
 }

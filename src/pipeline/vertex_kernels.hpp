@@ -19,6 +19,7 @@ namespace softrast::detail {
 struct PackedVertex {
   int32_t x, y;  // 1/256 pixel
   float z, inv_w;
+  float x_residual, y_residual;  // WindowVertex's
 };
 
 struct VertexBatch {

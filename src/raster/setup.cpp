@@ -65,6 +65,15 @@ PixelRect triangle_bounds(const int32_t vx[3], const int32_t vy[3]) {
 }
 
 // Fills the planes for depth, 1/w and varying/w of the (already reordered) triangle.
+//
+// The planes pass through the vertices where the application put them, not where snapping to
+// 1/256 pixel moved them (the residuals of WindowVertex), as Mesa's llvmpipe and the exact
+// result do: for a sliver whose height is a few 1/256 of a pixel, the snapped vertices tilt the
+// planes enough that a minified texture lookup lands several texels away. The planes stay
+// referenced at the snapped vertex 0, which float holds exactly (x_ref, y_ref): a0 is the exact
+// plane's value there. When snapping changed the triangle's shape so much that the exact area is
+// under a sixteenth of the snapped one (or of the other sign), the exact planes' gradients would
+// be unbounded where coverage still finds samples; those keep the snapped shape.
 void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area_fx16,
                   Interpolants& out) {
   PlaneBasis g;
@@ -73,15 +82,42 @@ void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area
   g.dy1 = to_pixels(v[1]->y - v[0]->y);
   g.dy2 = to_pixels(v[2]->y - v[0]->y);
   g.inv_area2 = double(kSubpixelOne) * kSubpixelOne / double(area_fx16);
+  // The exact vertices, relative to the snapped vertex 0 (rx0, ry0: vertex 0's own residual).
+  const double rx0 = to_pixels(1) * v[0]->x_residual, ry0 = to_pixels(1) * v[0]->y_residual;
+  PlaneBasis e;
+  e.dx1 = g.dx1 + (to_pixels(1) * v[1]->x_residual - rx0);
+  e.dx2 = g.dx2 + (to_pixels(1) * v[2]->x_residual - rx0);
+  e.dy1 = g.dy1 + (to_pixels(1) * v[1]->y_residual - ry0);
+  e.dy2 = g.dy2 + (to_pixels(1) * v[2]->y_residual - ry0);
+  double exact_area2 = e.dx1 * e.dy2 - e.dx2 * e.dy1;  // positive for the clockwise order
+  double snapped_area2 = double(area_fx16) / (double(kSubpixelOne) * kSubpixelOne);
+  bool exact = (rx0 != 0.0 || ry0 != 0.0 || e.dx1 != g.dx1 || e.dx2 != g.dx2 || e.dy1 != g.dy1 ||
+                e.dy2 != g.dy2) &&
+               exact_area2 >= snapped_area2 * (1.0 / 16.0);
+  if (exact) e.inv_area2 = 1.0 / exact_area2;
+  const PlaneBasis& basis = exact ? e : g;
+  // Moves a plane through the exact vertex 0 to the snapped one: a0 - dadx rx0 - dady ry0 (the
+  // gradients in double, before make_plane rounds them).
+  auto plane = [&](double a0, double a1, double a2) {
+    if (!exact) return make_plane(g, a0, a1, a2);
+    double da1 = a1 - a0, da2 = a2 - a0;
+    double dadx = (da1 * basis.dy2 - da2 * basis.dy1) * basis.inv_area2;
+    double dady = (da2 * basis.dx1 - da1 * basis.dx2) * basis.inv_area2;
+    Plane p;
+    p.a0 = float(a0 - dadx * rx0 - dady * ry0);
+    p.dadx = float(dadx);
+    p.dady = float(dady);
+    return p;
+  };
   out.x_ref = float(to_pixels(v[0]->x));
   out.y_ref = float(to_pixels(v[0]->y));
-  out.z = make_plane(g, v[0]->z, v[1]->z, v[2]->z);
-  out.inv_w = make_plane(g, v[0]->inv_w, v[1]->inv_w, v[2]->inv_w);
+  out.z = plane(v[0]->z, v[1]->z, v[2]->z);
+  out.inv_w = plane(v[0]->inv_w, v[1]->inv_w, v[2]->inv_w);
   const float *a0 = v[0]->varyings, *a1 = v[1]->varyings, *a2 = v[2]->varyings;
   for (int i = 0; i < num_varyings; ++i) {
     // float * float is exact in double.
-    out.var[i] = make_plane(g, double(a0[i]) * v[0]->inv_w, double(a1[i]) * v[1]->inv_w,
-                            double(a2[i]) * v[2]->inv_w);
+    out.var[i] = plane(double(a0[i]) * v[0]->inv_w, double(a1[i]) * v[1]->inv_w,
+                       double(a2[i]) * v[2]->inv_w);
   }
   out.num_varyings = num_varyings;
 }

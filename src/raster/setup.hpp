@@ -19,6 +19,11 @@ struct WindowVertex {
   float z = 0.0f;                   // window depth in [0, 1]
   float inv_w = 1.0f;               // 1 / clip w
   const float* varyings = nullptr;  // num_varyings floats, not yet divided by w
+  // What snapping moved: the exact window position minus (x, y), in 1/256 pixel (|r| <= 1/2; 0
+  // where the position was clamped). Coverage uses the snapped position; the attribute planes use
+  // the exact one, as the application gave it (see setup_planes).
+  float x_residual = 0.0f;
+  float y_residual = 0.0f;
 };
 
 // E(x, y) = a * x + b * y + c with x, y in 1/256 pixel. The sample (x, y) is covered by the
