@@ -112,8 +112,11 @@ void shade_quad(const S& shader, const ShadeTarget& target, const Interpolants& 
 
   float var[4][kN];
   for (int k = 0; k < 4; ++k) {
-    // Helper pixels outside the primitive extrapolate; keep their 1/w positive and finite.
-    float inv_w = std::max(eval_plane(in.inv_w, dx[k], dy[k]), 1.0e-30f);
+    // Helper pixels outside the primitive extrapolate, past the horizon too, where 1/w is
+    // negative: the varyings there are the projective continuation (what GPUs and llvmpipe
+    // compute), which keeps derivatives finite. Only a 1/w too close to 0 to divide by is moved.
+    float inv_w = eval_plane(in.inv_w, dx[k], dy[k]);
+    if (inv_w < 1.0e-30f && inv_w > -1.0e-30f) inv_w = 1.0e-30f;
     float w = 1.0f / inv_w;
     for (int i = 0; i < S::kVaryings; ++i) var[k][i] = eval_plane(in.var[i], dx[k], dy[k]) * w;
   }

@@ -203,9 +203,12 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
     }
   }
 
-  // Helper pixels outside the primitive extrapolate; keep their 1/w positive and finite.
+  // Helper pixels outside the primitive extrapolate, past the horizon too, where 1/w is negative:
+  // the varyings there are the projective continuation (what GPUs and llvmpipe compute), which
+  // keeps derivatives finite (clamping 1/w to a tiny positive value made them huge and sent
+  // trilinear lookups to the last mip level). Only a 1/w too close to 0 to divide by is moved.
   F inv_w = eval_plane<N>(in.inv_w, dx, dy);
-  inv_w = simd::select(inv_w < F(1.0e-30f), F(1.0e-30f), inv_w);
+  inv_w = simd::select((inv_w < F(1.0e-30f)) & (inv_w > F(-1.0e-30f)), F(1.0e-30f), inv_w);
   F w = F(1.0f) / inv_w;
   F var[kN];
   for (int i = 0; i < S::kVaryings; ++i) var[i] = eval_plane<N>(in.var[i], dx, dy) * w;
