@@ -28,6 +28,8 @@
 #include "softrast/renderer.hpp"
 
 #ifdef SOFTRAST_HAVE_SDL2
+#include <dlfcn.h>
+
 #include <SDL.h>
 #endif
 
@@ -139,6 +141,90 @@ int view_command(const ViewArgs&, void (*report)(std::string message)) {
 
 #else
 
+// SDL2 is opened when the viewer starts, not linked: linked, it brought 50 shared libraries
+// (X11, Wayland, PulseAudio and their codecs) into every run of the command line, and loading
+// them was a fifth of the time of a whole `softrast render` process. Only the functions the
+// viewer calls are looked up.
+namespace {
+
+struct SdlApi {
+  decltype(&SDL_Quit) Quit = nullptr;
+  decltype(&SDL_PollEvent) PollEvent = nullptr;
+  decltype(&SDL_Init) Init = nullptr;
+  decltype(&SDL_GetError) GetError = nullptr;
+  decltype(&SDL_DestroyTexture) DestroyTexture = nullptr;
+  decltype(&SDL_WaitEventTimeout) WaitEventTimeout = nullptr;
+  decltype(&SDL_UnlockTexture) UnlockTexture = nullptr;
+  decltype(&SDL_SetWindowTitle) SetWindowTitle = nullptr;
+  decltype(&SDL_SetTextureBlendMode) SetTextureBlendMode = nullptr;
+  decltype(&SDL_RenderPresent) RenderPresent = nullptr;
+  decltype(&SDL_RenderCopy) RenderCopy = nullptr;
+  decltype(&SDL_RenderClear) RenderClear = nullptr;
+  decltype(&SDL_LockTexture) LockTexture = nullptr;
+  decltype(&SDL_GetWindowSize) GetWindowSize = nullptr;
+  decltype(&SDL_GetRendererOutputSize) GetRendererOutputSize = nullptr;
+  decltype(&SDL_DestroyWindow) DestroyWindow = nullptr;
+  decltype(&SDL_DestroyRenderer) DestroyRenderer = nullptr;
+  decltype(&SDL_CreateWindow) CreateWindow = nullptr;
+  decltype(&SDL_CreateTexture) CreateTexture = nullptr;
+  decltype(&SDL_CreateRenderer) CreateRenderer = nullptr;
+};
+
+SdlApi g_sdl;
+
+const SdlApi& sdl() { return g_sdl; }
+
+// Opens libSDL2 and fills g_sdl; false with `error` set when the library or a function is missing.
+bool open_sdl(std::string& error) {
+  static bool opened = false;
+  if (opened) return true;
+  void* library = dlopen("libSDL2-2.0.so.0", RTLD_NOW | RTLD_LOCAL);
+  if (!library) {
+    const char* why = dlerror();
+    error = std::string("cannot open SDL2 (libSDL2-2.0.so.0, Debian's libsdl2-2.0-0): ") +
+            (why ? why : "unknown error");
+    return false;
+  }
+  SdlApi api;
+  const char* missing = nullptr;
+  auto load = [&](auto& slot, const char* name) {
+    slot = reinterpret_cast<std::remove_reference_t<decltype(slot)>>(dlsym(library, name));
+    if (!slot) missing = name;
+    return slot != nullptr;
+  };
+  bool ok =
+      load(api.Quit, "SDL_Quit") &&
+      load(api.PollEvent, "SDL_PollEvent") &&
+      load(api.Init, "SDL_Init") &&
+      load(api.GetError, "SDL_GetError") &&
+      load(api.DestroyTexture, "SDL_DestroyTexture") &&
+      load(api.WaitEventTimeout, "SDL_WaitEventTimeout") &&
+      load(api.UnlockTexture, "SDL_UnlockTexture") &&
+      load(api.SetWindowTitle, "SDL_SetWindowTitle") &&
+      load(api.SetTextureBlendMode, "SDL_SetTextureBlendMode") &&
+      load(api.RenderPresent, "SDL_RenderPresent") &&
+      load(api.RenderCopy, "SDL_RenderCopy") &&
+      load(api.RenderClear, "SDL_RenderClear") &&
+      load(api.LockTexture, "SDL_LockTexture") &&
+      load(api.GetWindowSize, "SDL_GetWindowSize") &&
+      load(api.GetRendererOutputSize, "SDL_GetRendererOutputSize") &&
+      load(api.DestroyWindow, "SDL_DestroyWindow") &&
+      load(api.DestroyRenderer, "SDL_DestroyRenderer") &&
+      load(api.CreateWindow, "SDL_CreateWindow") &&
+      load(api.CreateTexture, "SDL_CreateTexture") &&
+      load(api.CreateRenderer, "SDL_CreateRenderer") &&
+      true;
+  if (!ok) {
+    error = std::string("the SDL2 library has no ") + (missing ? missing : "?");
+    return false;
+  }
+  g_sdl = api;
+  opened = true;
+  return true;
+}
+
+}  // namespace
+
 namespace {
 
 constexpr std::array<ShaderKind, 8> kShaderCycle = {
@@ -184,17 +270,17 @@ class Viewer {
         light_(spec_.options.light_direction) {}
 
   ~Viewer() {
-    if (texture_) SDL_DestroyTexture(texture_);
-    if (renderer_) SDL_DestroyRenderer(renderer_);
-    if (window_) SDL_DestroyWindow(window_);
+    if (texture_) sdl().DestroyTexture(texture_);
+    if (renderer_) sdl().DestroyRenderer(renderer_);
+    if (window_) sdl().DestroyWindow(window_);
   }
 
   Status open() {
     window_ =
-        SDL_CreateWindow("softrast", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, spec_.width,
+        sdl().CreateWindow("softrast", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, spec_.width,
                          spec_.height, SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI);
     if (!window_) return sdl_error("cannot open a window");
-    renderer_ = SDL_CreateRenderer(window_, -1, 0);
+    renderer_ = sdl().CreateRenderer(window_, -1, 0);
     if (!renderer_) return sdl_error("cannot create an SDL renderer");
     return resize();
   }
@@ -209,9 +295,9 @@ class Viewer {
       }
       SDL_Event event;
       bool waiting = !args_.continuous;
-      if (waiting && !SDL_WaitEventTimeout(&event, 500)) continue;
+      if (waiting && !sdl().WaitEventTimeout(&event, 500)) continue;
       if (waiting) dirty |= handle(event);
-      while (SDL_PollEvent(&event)) dirty |= handle(event);
+      while (sdl().PollEvent(&event)) dirty |= handle(event);
       if (resized_) {
         if (Status s = resize(); !s.ok()) return s;
       }
@@ -221,25 +307,25 @@ class Viewer {
 
  private:
   static Status sdl_error(const std::string& what) {
-    return Status::error(what + ": " + SDL_GetError());
+    return Status::error(what + ": " + sdl().GetError());
   }
 
   // Framebuffer and texture at the drawable size (larger than the window's on HiDPI screens).
   Status resize() {
     resized_ = false;
     int w = 0, h = 0;
-    if (SDL_GetRendererOutputSize(renderer_, &w, &h) != 0) return sdl_error("window size");
+    if (sdl().GetRendererOutputSize(renderer_, &w, &h) != 0) return sdl_error("window size");
     w = std::clamp(w, 1, kMaxImageSize);
     h = std::clamp(h, 1, kMaxImageSize);
     if (framebuffer_ && framebuffer_->width() == w && framebuffer_->height() == h) return {};
     Result<Framebuffer> fb = Framebuffer::create(w, h);
     if (!fb) return fb.status();
     framebuffer_ = std::move(*fb);
-    if (texture_) SDL_DestroyTexture(texture_);
+    if (texture_) sdl().DestroyTexture(texture_);
     texture_ =
-        SDL_CreateTexture(renderer_, SDL_PIXELFORMAT_RGBA32, SDL_TEXTUREACCESS_STREAMING, w, h);
+        sdl().CreateTexture(renderer_, SDL_PIXELFORMAT_RGBA32, SDL_TEXTUREACCESS_STREAMING, w, h);
     if (!texture_) return sdl_error("cannot create a texture");
-    SDL_SetTextureBlendMode(texture_, SDL_BLENDMODE_NONE);
+    sdl().SetTextureBlendMode(texture_, SDL_BLENDMODE_NONE);
     return {};
   }
 
@@ -263,14 +349,14 @@ class Viewer {
     Framebuffer& fb = *framebuffer_;
     void* pixels = nullptr;
     int pitch = 0;
-    if (SDL_LockTexture(texture_, nullptr, &pixels, &pitch) != 0) {
+    if (sdl().LockTexture(texture_, nullptr, &pixels, &pitch) != 0) {
       return sdl_error("cannot update the texture");
     }
     fb.copy_rgba8(static_cast<uint8_t*>(pixels), size_t(pitch));
-    SDL_UnlockTexture(texture_);
-    SDL_RenderClear(renderer_);
-    SDL_RenderCopy(renderer_, texture_, nullptr, nullptr);
-    SDL_RenderPresent(renderer_);
+    sdl().UnlockTexture(texture_);
+    sdl().RenderClear(renderer_);
+    sdl().RenderCopy(renderer_, texture_, nullptr, nullptr);
+    sdl().RenderPresent(renderer_);
     frame_ms_ = seconds_since(start) * 1000.0;
     ++frames_in_interval_;
     if (print_command_) print_command();
@@ -295,7 +381,7 @@ class Viewer {
                   fps, frame_ms_, render_ms_, scene_.mesh.triangle_count(), threads,
                   shader_kind_name(options_.shader), options_.wireframe_overlay ? "+wire" : "",
                   raster_name(), cull_name(), debug_view_name(options_.debug_view));
-    SDL_SetWindowTitle(window_, title);
+    sdl().SetWindowTitle(window_, title);
     interval_start_ = std::chrono::steady_clock::now();
     frames_in_interval_ = 0;
     force_title_ = false;
@@ -371,7 +457,7 @@ class Viewer {
         }
         if (e.motion.state & (SDL_BUTTON_RMASK | SDL_BUTTON_MMASK)) {
           int w = 0, h = 0;
-          SDL_GetWindowSize(window_, &w, &h);  // motion is in window (not drawable) pixels
+          sdl().GetWindowSize(window_, &w, &h);  // motion is in window (not drawable) pixels
           orbit_.pan(float(e.motion.xrel), float(e.motion.yrel), h);
           return true;
         }
@@ -443,7 +529,7 @@ class Viewer {
     auto start = std::chrono::steady_clock::now();
     for (int i = 0; i < frames && !quit_; ++i) {
       SDL_Event event;
-      while (SDL_PollEvent(&event)) handle(event);
+      while (sdl().PollEvent(&event)) handle(event);
       if (Status s = present(); !s.ok()) return s;
       frame_ms.push_back(frame_ms_);
       render_ms.push_back(render_ms_);
@@ -488,9 +574,9 @@ class Viewer {
 
 // SDL_Init and SDL_Quit around the viewer's lifetime.
 struct SdlVideo {
-  bool ok = SDL_Init(SDL_INIT_VIDEO) == 0;
+  bool ok = sdl().Init(SDL_INIT_VIDEO) == 0;
   ~SdlVideo() {
-    if (ok) SDL_Quit();
+    if (ok) sdl().Quit();
   }
 };
 
@@ -516,6 +602,11 @@ int view_command(const ViewArgs& args, void (*report)(std::string message)) {
     report("no display to open a window on (DISPLAY and WAYLAND_DISPLAY are not set)");
     return kExitRuntime;
   }
+  std::string sdl_error;
+  if (!open_sdl(sdl_error)) {
+    report(sdl_error);
+    return kExitRuntime;
+  }
   Result<ViewScene> scene = load_view_scene(args.models, float(spec->width) / float(spec->height));
   if (!scene) {
     report(scene.status().message());
@@ -528,7 +619,7 @@ int view_command(const ViewArgs& args, void (*report)(std::string message)) {
   }
   SdlVideo video;
   if (!video.ok) {
-    report(std::string("cannot start SDL's video (is there a display?): ") + SDL_GetError());
+    report(std::string("cannot start SDL's video (is there a display?): ") + sdl().GetError());
     return kExitRuntime;
   }
   Viewer viewer(checked, std::move(*spec), std::move(*scene));

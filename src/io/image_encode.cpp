@@ -5,8 +5,10 @@
 // render. Here:
 //  - every row uses the SUB filter: one subtraction per byte and no trial of the other filters;
 //    on rendered images (flat backgrounds, smooth shading) it leaves long runs of small values;
-//  - zlib compresses at level 1, its fastest matching, which on such rows gives files about two
-//    thirds the size of stb's at a tenth of the time;
+//  - zlib compresses at level 1 with the Z_RLE strategy (matches only at distance one pixel
+//    byte, i.e. runs): on SUB-filtered rendered rows that is both faster and smaller than level 1's
+//    general matching (diablo3_pose at 1920x1080: 355 KB against 422 KB, about 1 ms less); level
+//    1 had already given files about two thirds the size of stb's at a tenth of the time;
 //  - the rows are compressed in strips of kStripRows rows on the library's worker threads, each a
 //    raw deflate stream ended by a sync flush (byte-aligned, not final) except the last, so that
 //    their concatenation is one valid zlib stream (the method of pigz); the Adler-32 checksums of
@@ -80,7 +82,7 @@ class StripCompressor {
  public:
   StripCompressor(const Image& image, bool rgb) : image_(image), rgb_(rgb) {
     row_bytes_ = 1 + size_t(image.width) * (rgb ? 3 : 4);
-    ok_ = deflateInit2(&z_, 1, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY) == Z_OK;
+    ok_ = deflateInit2(&z_, 1, Z_DEFLATED, -15, 8, Z_RLE) == Z_OK;
     if (ok_) out_.resize(deflateBound(&z_, uLong(row_bytes_ * kStripRows)) + 64);
     rows_.resize(row_bytes_ * kFeedRows);
   }
