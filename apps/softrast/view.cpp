@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -172,7 +173,9 @@ struct SdlApi {
 
 SdlApi g_sdl;
 
-const SdlApi& sdl() { return g_sdl; }
+const SdlApi& sdl() {
+  return g_sdl;
+}
 
 // Opens libSDL2 and fills g_sdl; false with `error` set when the library or a function is missing.
 bool open_sdl(std::string& error) {
@@ -188,32 +191,27 @@ bool open_sdl(std::string& error) {
   SdlApi api;
   const char* missing = nullptr;
   auto load = [&](auto& slot, const char* name) {
-    slot = reinterpret_cast<std::remove_reference_t<decltype(slot)>>(dlsym(library, name));
+    using Slot = std::remove_reference_t<decltype(slot)>;
+    slot = reinterpret_cast<Slot>(dlsym(library, name));
     if (!slot) missing = name;
     return slot != nullptr;
   };
   bool ok =
-      load(api.Quit, "SDL_Quit") &&
-      load(api.PollEvent, "SDL_PollEvent") &&
-      load(api.Init, "SDL_Init") &&
-      load(api.GetError, "SDL_GetError") &&
+      load(api.Quit, "SDL_Quit") && load(api.PollEvent, "SDL_PollEvent") &&
+      load(api.Init, "SDL_Init") && load(api.GetError, "SDL_GetError") &&
       load(api.DestroyTexture, "SDL_DestroyTexture") &&
       load(api.WaitEventTimeout, "SDL_WaitEventTimeout") &&
       load(api.UnlockTexture, "SDL_UnlockTexture") &&
       load(api.SetWindowTitle, "SDL_SetWindowTitle") &&
       load(api.SetTextureBlendMode, "SDL_SetTextureBlendMode") &&
-      load(api.RenderPresent, "SDL_RenderPresent") &&
-      load(api.RenderCopy, "SDL_RenderCopy") &&
-      load(api.RenderClear, "SDL_RenderClear") &&
-      load(api.LockTexture, "SDL_LockTexture") &&
+      load(api.RenderPresent, "SDL_RenderPresent") && load(api.RenderCopy, "SDL_RenderCopy") &&
+      load(api.RenderClear, "SDL_RenderClear") && load(api.LockTexture, "SDL_LockTexture") &&
       load(api.GetWindowSize, "SDL_GetWindowSize") &&
       load(api.GetRendererOutputSize, "SDL_GetRendererOutputSize") &&
       load(api.DestroyWindow, "SDL_DestroyWindow") &&
       load(api.DestroyRenderer, "SDL_DestroyRenderer") &&
-      load(api.CreateWindow, "SDL_CreateWindow") &&
-      load(api.CreateTexture, "SDL_CreateTexture") &&
-      load(api.CreateRenderer, "SDL_CreateRenderer") &&
-      true;
+      load(api.CreateWindow, "SDL_CreateWindow") && load(api.CreateTexture, "SDL_CreateTexture") &&
+      load(api.CreateRenderer, "SDL_CreateRenderer") && true;
   if (!ok) {
     error = std::string("the SDL2 library has no ") + (missing ? missing : "?");
     return false;
@@ -276,9 +274,9 @@ class Viewer {
   }
 
   Status open() {
-    window_ =
-        sdl().CreateWindow("softrast", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, spec_.width,
-                         spec_.height, SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI);
+    window_ = sdl().CreateWindow("softrast", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED,
+                                 spec_.width, spec_.height,
+                                 SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI);
     if (!window_) return sdl_error("cannot open a window");
     renderer_ = sdl().CreateRenderer(window_, -1, 0);
     if (!renderer_) return sdl_error("cannot create an SDL renderer");
