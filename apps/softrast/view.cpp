@@ -148,27 +148,20 @@ int view_command(const ViewArgs&, void (*report)(std::string message)) {
 // viewer calls are looked up.
 namespace {
 
+// The SDL functions the viewer calls, each X(name) for SDL_name: the table's members and the
+// names looked up come from this one list.
+// clang-format off
+#define SOFTRAST_SDL_FUNCTIONS(X)                                                          \
+  X(Quit) X(PollEvent) X(Init) X(GetError) X(DestroyTexture) X(WaitEventTimeout)           \
+  X(UnlockTexture) X(SetWindowTitle) X(SetTextureBlendMode) X(RenderPresent) X(RenderCopy) \
+  X(RenderClear) X(LockTexture) X(GetWindowSize) X(GetRendererOutputSize) X(DestroyWindow) \
+  X(DestroyRenderer) X(CreateWindow) X(CreateTexture) X(CreateRenderer)
+// clang-format on
+
 struct SdlApi {
-  decltype(&SDL_Quit) Quit = nullptr;
-  decltype(&SDL_PollEvent) PollEvent = nullptr;
-  decltype(&SDL_Init) Init = nullptr;
-  decltype(&SDL_GetError) GetError = nullptr;
-  decltype(&SDL_DestroyTexture) DestroyTexture = nullptr;
-  decltype(&SDL_WaitEventTimeout) WaitEventTimeout = nullptr;
-  decltype(&SDL_UnlockTexture) UnlockTexture = nullptr;
-  decltype(&SDL_SetWindowTitle) SetWindowTitle = nullptr;
-  decltype(&SDL_SetTextureBlendMode) SetTextureBlendMode = nullptr;
-  decltype(&SDL_RenderPresent) RenderPresent = nullptr;
-  decltype(&SDL_RenderCopy) RenderCopy = nullptr;
-  decltype(&SDL_RenderClear) RenderClear = nullptr;
-  decltype(&SDL_LockTexture) LockTexture = nullptr;
-  decltype(&SDL_GetWindowSize) GetWindowSize = nullptr;
-  decltype(&SDL_GetRendererOutputSize) GetRendererOutputSize = nullptr;
-  decltype(&SDL_DestroyWindow) DestroyWindow = nullptr;
-  decltype(&SDL_DestroyRenderer) DestroyRenderer = nullptr;
-  decltype(&SDL_CreateWindow) CreateWindow = nullptr;
-  decltype(&SDL_CreateTexture) CreateTexture = nullptr;
-  decltype(&SDL_CreateRenderer) CreateRenderer = nullptr;
+#define SOFTRAST_SDL_MEMBER(name) decltype(&SDL_##name) name = nullptr;
+  SOFTRAST_SDL_FUNCTIONS(SOFTRAST_SDL_MEMBER)
+#undef SOFTRAST_SDL_MEMBER
 };
 
 SdlApi g_sdl;
@@ -196,22 +189,10 @@ bool open_sdl(std::string& error) {
     if (!slot) missing = name;
     return slot != nullptr;
   };
-  bool ok =
-      load(api.Quit, "SDL_Quit") && load(api.PollEvent, "SDL_PollEvent") &&
-      load(api.Init, "SDL_Init") && load(api.GetError, "SDL_GetError") &&
-      load(api.DestroyTexture, "SDL_DestroyTexture") &&
-      load(api.WaitEventTimeout, "SDL_WaitEventTimeout") &&
-      load(api.UnlockTexture, "SDL_UnlockTexture") &&
-      load(api.SetWindowTitle, "SDL_SetWindowTitle") &&
-      load(api.SetTextureBlendMode, "SDL_SetTextureBlendMode") &&
-      load(api.RenderPresent, "SDL_RenderPresent") && load(api.RenderCopy, "SDL_RenderCopy") &&
-      load(api.RenderClear, "SDL_RenderClear") && load(api.LockTexture, "SDL_LockTexture") &&
-      load(api.GetWindowSize, "SDL_GetWindowSize") &&
-      load(api.GetRendererOutputSize, "SDL_GetRendererOutputSize") &&
-      load(api.DestroyWindow, "SDL_DestroyWindow") &&
-      load(api.DestroyRenderer, "SDL_DestroyRenderer") &&
-      load(api.CreateWindow, "SDL_CreateWindow") && load(api.CreateTexture, "SDL_CreateTexture") &&
-      load(api.CreateRenderer, "SDL_CreateRenderer") && true;
+  bool ok = true;
+#define SOFTRAST_SDL_LOAD(name) ok = ok && load(api.name, "SDL_" #name);
+  SOFTRAST_SDL_FUNCTIONS(SOFTRAST_SDL_LOAD)
+#undef SOFTRAST_SDL_LOAD
   if (!ok) {
     error = std::string("the SDL2 library has no ") + (missing ? missing : "?");
     return false;

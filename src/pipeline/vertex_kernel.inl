@@ -69,8 +69,8 @@ void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
       float zf = float(wz[l]);
       // geometry_stage.hpp: the depth bias, in float.
       if (b.depth_bias != 0.0f) zf = std::clamp(zf + b.depth_bias, 0.0f, 1.0f);
-      b.window[i + l] = {int32_t(wx[l]), int32_t(wy[l]), zf, float(inv_w[l]), float(rx[l]),
-                         float(ry[l])};
+      b.window[i + l] = {int32_t(wx[l]),  int32_t(wy[l]), zf,
+                         float(inv_w[l]), float(rx[l]),   float(ry[l])};
     }
   }
 }
