@@ -37,6 +37,7 @@ struct Native<4> {
   typedef float F __attribute__((vector_size(16)));
   typedef int32_t I __attribute__((vector_size(16)));
   typedef uint32_t U __attribute__((vector_size(16)));
+  typedef double D __attribute__((vector_size(32)));  // N doubles (depth)
   // For loads and stores at any 4-byte aligned address, through any type.
   typedef float FU __attribute__((vector_size(16), aligned(4), may_alias));
   typedef int32_t IU __attribute__((vector_size(16), aligned(4), may_alias));
@@ -46,6 +47,7 @@ struct Native<8> {
   typedef float F __attribute__((vector_size(32)));
   typedef int32_t I __attribute__((vector_size(32)));
   typedef uint32_t U __attribute__((vector_size(32)));
+  typedef double D __attribute__((vector_size(64)));  // N doubles (depth)
   // For loads and stores at any 4-byte aligned address, through any type.
   typedef float FU __attribute__((vector_size(32), aligned(4), may_alias));
   typedef int32_t IU __attribute__((vector_size(32), aligned(4), may_alias));
@@ -55,6 +57,7 @@ struct Native<16> {
   typedef float F __attribute__((vector_size(64)));
   typedef int32_t I __attribute__((vector_size(64)));
   typedef uint32_t U __attribute__((vector_size(64)));
+  typedef double D __attribute__((vector_size(128)));  // N doubles (depth)
   // For loads and stores at any 4-byte aligned address, through any type.
   typedef float FU __attribute__((vector_size(64), aligned(4), may_alias));
   typedef int32_t IU __attribute__((vector_size(64), aligned(4), may_alias));

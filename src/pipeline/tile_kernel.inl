@@ -9,6 +9,7 @@ constexpr int kGroups = 16 / kLanes;  // a 4x4 block is kGroups vectors of kLane
 typedef float F __attribute__((vector_size(4 * kLanes)));
 typedef int32_t I __attribute__((vector_size(4 * kLanes)));
 typedef int64_t L __attribute__((vector_size(8 * kLanes)));
+typedef double D __attribute__((vector_size(8 * kLanes)));
 
 // Lane l of group g is pixel p = g * kLanes + l of the block: column p & 3, row p >> 2 (the bit
 // of the coverage masks).
@@ -66,22 +67,22 @@ template <class V, class T>
 // The depth resolve of one block (tile_visibility.hpp): the fragment stage's depth, exactly, tested
 // against the tile's depth; where it passes, depth and winner id are written.
 //
-// The fragment stage computes dx = (float(px) + 0.5f) - x_ref and z = clamp((a0 + dadx * dx) +
-// dady * dy, 0, 1) with std::clamp (NaN stays NaN, -0 stays -0), without contraction. Here
-// float(px) + 0.5f is formed as (float(x) + 0.5f) + column: both are exact (integers and
-// half-integers below 2^23, the image is at most 16384 wide), so only the subtraction of x_ref
-// rounds, as there. std::clamp(z, 0, 1) is `z < 0 ? 0 : (1 < z ? 1 : z)`, which is exactly
-// max(0, min(1, z)) with x86's operand order (MINPS returns its second operand unless the first
-// is smaller, so NaN and -0 come through as z).
+// The fragment stage computes dx = (float(px) + 0.5f) - x_ref and z = clamp(float((a0 + dadx * dx)
+// + dady * dy), 0, 1), the plane in double (interpolants.hpp: DepthPlane), with std::clamp (NaN
+// stays NaN, -0 stays -0), without contraction. Here float(px) + 0.5f is formed as (float(x) +
+// 0.5f) + column: both are exact (integers and half-integers below 2^23, the image is at most
+// 16384 wide), so only the subtraction of x_ref rounds, as there. std::clamp(z, 0, 1) is `z < 0 ?
+// 0 : (1 < z ? 1 : z)`, which is exactly max(0, min(1, z)) with x86's operand order (MINPS returns
+// its second operand unless the first is smaller, so NaN and -0 come through as z).
 
 // A triangle's depth plane over an area of at most a tile, as its two halves: the fragment
-// stage's z = (a0 + dadx * dx) + dady * dy is the sum of a term per block column and a term per
-// block row, each computed once from the same operands (so each block's z is the same float sum,
-// for one addition).
+// stage's (a0 + dadx * dx) + dady * dy is the sum of a term per block column and a term per block
+// row, each computed once from the same operands (so each block's z is the same double sum, for
+// one addition and one rounding to float).
 struct DepthTerms {
   static constexpr int kMax = kTileSize / kBlockSize;
-  F x_term[kMax][kGroups];  // a0 + dadx * dx, block column i (pixels x0 + 4 i ..)
-  F y_term[kMax][kGroups];  // dady * dy, block row j
+  D x_term[kMax][kGroups];  // a0 + dadx * dx, block column i (pixels x0 + 4 i ..)
+  D y_term[kMax][kGroups];  // dady * dy, block row j
   int x0, y0;
   int32_t id;
 };
@@ -93,16 +94,17 @@ struct DepthTerms {
   d.y0 = y0;
   d.id = id;
   F x_ref = F{} + in.x_ref, y_ref = F{} + in.y_ref;
+  D a0 = D{} + in.z.a0, dadx = D{} + in.z.dadx, dady = D{} + in.z.dady;
   for (int g = 0; g < kGroups; ++g) {
     I p = pixel_index(g);
     F column = __builtin_convertvector(p & 3, F), row = __builtin_convertvector(p >> 2, F);
     for (int i = 0; x0 + kBlockSize * i < x1; ++i) {
       F dx = ((F{} + (float(x0 + kBlockSize * i) + 0.5f)) + column) - x_ref;
-      d.x_term[i][g] = in.z.a0 + in.z.dadx * dx;
+      d.x_term[i][g] = a0 + dadx * __builtin_convertvector(dx, D);
     }
     for (int j = 0; y0 + kBlockSize * j < y1; ++j) {
       F dy = ((F{} + (float(y0 + kBlockSize * j) + 0.5f)) + row) - y_ref;
-      d.y_term[j][g] = in.z.dady * dy;
+      d.y_term[j][g] = dady * __builtin_convertvector(dy, D);
     }
   }
 }
@@ -151,12 +153,12 @@ template <bool kLessEqual>
 template <bool kLessEqual>
 [[gnu::always_inline]] inline void resolve_lanes(const DepthTerms& d, int x, int y, uint32_t mask,
                                                  float* depth, int32_t* ids) {
-  const F* x_term = d.x_term[(x - d.x0) >> 2];
-  const F* y_term = d.y_term[(y - d.y0) >> 2];
+  const D* x_term = d.x_term[(x - d.x0) >> 2];
+  const D* y_term = d.y_term[(y - d.y0) >> 2];
   for (int g = 0; g < kGroups; ++g) {
     uint32_t group_mask = (mask >> (g * kLanes)) & ((1u << kLanes) - 1u);
     if (kGroups > 1 && group_mask == 0) continue;
-    F z = clamp01(x_term[g] + y_term[g]);
+    F z = clamp01(__builtin_convertvector(x_term[g] + y_term[g], F));
     test_and_write<kLessEqual>(z, group_mask, d.id, depth + g * kLanes, ids + g * kLanes);
   }
 }

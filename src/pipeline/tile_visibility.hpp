@@ -68,7 +68,7 @@ struct TileVisibility {
 // stage evaluates it) and the id recorded for the pixels it wins.
 struct DepthPlaneRef {
   float x_ref, y_ref;
-  Plane z;
+  DepthPlane z;
 };
 
 // Depth-tests the pixels of `mask` in the 4x4 block at pixel (x, y) of the tile against the

@@ -41,14 +41,20 @@ struct PlaneBasis {
   double dx1, dx2, dy1, dy2, inv_area2;
 };
 
-// The plane through the vertices with values a0, a1, a2, referenced at vertex 0.
-Plane make_plane(const PlaneBasis& g, double a0, double a1, double a2) {
+// The plane through the vertices with values a0, a1, a2 (the basis's vertex 0 at (rx0, ry0) from
+// the reference point), in double; the depth plane stays so, the others are rounded by to_float.
+DepthPlane make_plane(const PlaneBasis& g, double rx0, double ry0, double a0, double a1,
+                      double a2) {
   double da1 = a1 - a0, da2 = a2 - a0;
-  Plane p;
-  p.a0 = float(a0);
-  p.dadx = float((da1 * g.dy2 - da2 * g.dy1) * g.inv_area2);
-  p.dady = float((da2 * g.dx1 - da1 * g.dx2) * g.inv_area2);
+  DepthPlane p;
+  p.dadx = (da1 * g.dy2 - da2 * g.dy1) * g.inv_area2;
+  p.dady = (da2 * g.dx1 - da1 * g.dx2) * g.inv_area2;
+  p.a0 = (rx0 != 0.0 || ry0 != 0.0) ? a0 - p.dadx * rx0 - p.dady * ry0 : a0;
   return p;
+}
+
+Plane to_float(const DepthPlane& p) {
+  return {float(p.a0), float(p.dadx), float(p.dady)};
 }
 
 PixelRect triangle_bounds(const int32_t vx[3], const int32_t vy[3]) {
@@ -95,29 +101,21 @@ void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area
                 e.dy2 != g.dy2) &&
                exact_area2 >= snapped_area2 * (1.0 / 16.0);
   if (exact) e.inv_area2 = 1.0 / exact_area2;
+  // The exact planes pass through the exact vertex 0, which is (rx0, ry0) from the snapped one.
   const PlaneBasis& basis = exact ? e : g;
-  // Moves a plane through the exact vertex 0 to the snapped one: a0 - dadx rx0 - dady ry0 (the
-  // gradients in double, before make_plane rounds them).
+  const double ox = exact ? rx0 : 0.0, oy = exact ? ry0 : 0.0;
   auto plane = [&](double a0, double a1, double a2) {
-    if (!exact) return make_plane(g, a0, a1, a2);
-    double da1 = a1 - a0, da2 = a2 - a0;
-    double dadx = (da1 * basis.dy2 - da2 * basis.dy1) * basis.inv_area2;
-    double dady = (da2 * basis.dx1 - da1 * basis.dx2) * basis.inv_area2;
-    Plane p;
-    p.a0 = float(a0 - dadx * rx0 - dady * ry0);
-    p.dadx = float(dadx);
-    p.dady = float(dady);
-    return p;
+    return make_plane(basis, ox, oy, a0, a1, a2);
   };
   out.x_ref = float(to_pixels(v[0]->x));
   out.y_ref = float(to_pixels(v[0]->y));
   out.z = plane(v[0]->z, v[1]->z, v[2]->z);
-  out.inv_w = plane(v[0]->inv_w, v[1]->inv_w, v[2]->inv_w);
+  out.inv_w = to_float(plane(v[0]->inv_w, v[1]->inv_w, v[2]->inv_w));
   const float *a0 = v[0]->varyings, *a1 = v[1]->varyings, *a2 = v[2]->varyings;
   for (int i = 0; i < num_varyings; ++i) {
     // float * float is exact in double.
-    out.var[i] = plane(double(a0[i]) * v[0]->inv_w, double(a1[i]) * v[1]->inv_w,
-                       double(a2[i]) * v[2]->inv_w);
+    out.var[i] = to_float(plane(double(a0[i]) * v[0]->inv_w, double(a1[i]) * v[1]->inv_w,
+                                double(a2[i]) * v[2]->inv_w));
   }
   out.num_varyings = num_varyings;
 }
@@ -196,19 +194,19 @@ bool setup_line(const WindowVertex& v0, const WindowVertex& v1, int num_varyings
   bool x_major = std::llabs(dx) >= std::llabs(dy);
   double len = double(x_major ? dx : dy) / kSubpixelOne;
   auto line_plane = [&](double a0, double a1) {
-    Plane p;
-    p.a0 = float(a0);
-    float g = float((a1 - a0) / len);
-    (x_major ? p.dadx : p.dady) = g;
+    DepthPlane p;
+    p.a0 = a0;
+    (x_major ? p.dadx : p.dady) = (a1 - a0) / len;
     return p;
   };
   Interpolants& in = out.interp;
   in.x_ref = float(to_pixels(v0.x));
   in.y_ref = float(to_pixels(v0.y));
   in.z = line_plane(v0.z, v1.z);
-  in.inv_w = line_plane(v0.inv_w, v1.inv_w);
+  in.inv_w = to_float(line_plane(v0.inv_w, v1.inv_w));
   for (int i = 0; i < num_varyings; ++i) {
-    in.var[i] = line_plane(double(v0.varyings[i]) * v0.inv_w, double(v1.varyings[i]) * v1.inv_w);
+    in.var[i] =
+        to_float(line_plane(double(v0.varyings[i]) * v0.inv_w, double(v1.varyings[i]) * v1.inv_w));
   }
   in.num_varyings = num_varyings;
   in.front_facing = true;

@@ -23,6 +23,16 @@ struct Plane {
   float dady = 0.0f;
 };
 
+// Depth's plane, in double: on a steep or sliver triangle the terms dzdx (x - x_ref) and
+// dzdy (y - y_ref) grow far beyond the depth itself, and summed in float their rounding reaches
+// hundreds of units of a 24-bit depth buffer. In double the sum is exact to far below one unit,
+// and only the final value is rounded to float.
+struct DepthPlane {
+  double a0 = 0.0;
+  double dadx = 0.0;
+  double dady = 0.0;
+};
+
 // Everything the fragment stage needs of one primitive. Depth is linear in window space; the
 // varyings are stored divided by w, so value = plane(var) / plane(inv_w) is perspective-correct.
 // `var` comes last and the fragment stage reads only var[0 .. num_varyings): a producer may keep
@@ -30,7 +40,7 @@ struct Plane {
 struct Interpolants {
   float x_ref = 0.0f;
   float y_ref = 0.0f;
-  Plane z;
+  DepthPlane z;
   Plane inv_w;
   int num_varyings = 0;
   bool front_facing = true;

@@ -76,6 +76,10 @@ inline uint32_t blend_pixel(BlendMode mode, glm::vec4 src, uint32_t dst_packed) 
 inline float eval_plane(const Plane& p, float dx, float dy) {
   return p.a0 + p.dadx * dx + p.dady * dy;
 }
+// Depth: the plane in double, rounded to float once (interpolants.hpp).
+inline float eval_plane(const DepthPlane& p, float dx, float dy) {
+  return float(p.a0 + p.dadx * double(dx) + p.dady * double(dy));
+}
 
 // Shades the pixels of `quad_mask` (bit k = pixel (k & 1, k >> 1)) of the 2x2 quad at (x, y).
 // All four pixels are interpolated so that the shader gets derivatives, as GPUs do with helper

@@ -87,6 +87,20 @@ SOFTRAST_SIMD_INLINE simd::Float<N> eval_plane(const Plane& p, const simd::Float
   // The scalar eval_plane's operation order, so that both give the same bits.
   return simd::Float<N>(p.a0) + simd::Float<N>(p.dadx) * dx + simd::Float<N>(p.dady) * dy;
 }
+// Depth: the plane in double, rounded to float once, as the scalar eval_plane and the tile
+// kernels' depth resolve compute it (the same operations, so the same bits).
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Float<N> eval_plane(const DepthPlane& p, const simd::Float<N>& dx,
+                                               const simd::Float<N>& dy) {
+  using D = typename simd::Native<N>::D;
+  D a0 = D{} + p.a0, dadx = D{} + p.dadx, dady = D{} + p.dady;
+  simd::Float<N> z;
+  for (int k = 0; k < simd::Float<N>::kParts; ++k) {
+    D x = __builtin_convertvector(dx.p[k], D), y = __builtin_convertvector(dy.p[k], D);
+    z.p[k] = __builtin_convertvector((a0 + dadx * x) + dady * y, typename simd::Native<N>::F);
+  }
+  return z;
+}
 
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Int<N> depth_passes(DepthFunc f, const simd::Float<N>& z,
