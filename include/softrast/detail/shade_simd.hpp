@@ -299,8 +299,15 @@ template <class S>
   shade_block_level<S, 16>(shader, target, interp, x, y, mask);
 }
 
+// SOFTRAST_SHADERS_BASELINE_ONLY (the fuzz preset defines it) compiles each shader for the
+// baseline alone: libFuzzer's instrumentation of every shader at four levels made the two files
+// that hold the built-in shaders take most of an hour to build. Shading is then SSE2 at every
+// simd_level(); the tile and vertex kernels still follow it.
 template <class S>
-ShadeBlockFn wide_shade_block(SimdLevel level) {
+ShadeBlockFn wide_shade_block([[maybe_unused]] SimdLevel level) {
+#if defined(SOFTRAST_SHADERS_BASELINE_ONLY)
+  return &shade_block_sse2<S>;
+#else
   switch (level) {
     case SimdLevel::kAvx512:
       return &shade_block_avx512<S>;
@@ -312,6 +319,7 @@ ShadeBlockFn wide_shade_block(SimdLevel level) {
       break;
   }
   return &shade_block_sse2<S>;
+#endif
 }
 
 }  // namespace detail
