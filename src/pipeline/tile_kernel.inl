@@ -51,10 +51,59 @@ template <class V, class T>
   }
 }
 
+// The exact 64-bit path in the level's native vectors of int64 (2, 4 or 8 lanes): the broadcast
+// of each edge value and the sign bits written out, because GCC lowers the kLanes-wide int64
+// vectors above (two native registers) through the stack, lane by lane, and turns the 64-bit
+// comparison into 32-bit lanes by scalar extraction: that made the partial blocks of large
+// triangles cost several times a 32-bit block. `off`: EdgeOffsets<L>'s 3 x 16 values, pixel order.
+#if SOFTRAST_LANES == 16
+typedef int64_t LN __attribute__((vector_size(64)));
+[[gnu::always_inline]] inline LN splat64(int64_t v) {
+  return reinterpret_cast<LN>(_mm512_set1_epi64(v));
+}
+[[gnu::always_inline]] inline uint32_t sign_bits64(LN v) {
+  return uint32_t(_mm512_movepi64_mask(reinterpret_cast<__m512i>(v)));
+}
+#elif SOFTRAST_LANES == 8
+typedef int64_t LN __attribute__((vector_size(32)));
+[[gnu::always_inline]] inline LN splat64(int64_t v) {
+  return reinterpret_cast<LN>(_mm256_set1_epi64x(v));
+}
+[[gnu::always_inline]] inline uint32_t sign_bits64(LN v) {
+  return uint32_t(_mm256_movemask_pd(reinterpret_cast<__m256d>(v)));
+}
+#else
+typedef int64_t LN __attribute__((vector_size(16)));
+[[gnu::always_inline]] inline LN splat64(int64_t v) {
+  return reinterpret_cast<LN>(_mm_set1_epi64x(v));
+}
+[[gnu::always_inline]] inline uint32_t sign_bits64(LN v) {
+  return uint32_t(_mm_movemask_pd(reinterpret_cast<__m128d>(v)));
+}
+#endif
+constexpr int kNative64 = int(sizeof(LN) / 8);
+
+[[gnu::always_inline]] inline uint32_t coverage_bits_64(const int64_t e[3], const int64_t* off) {
+  LN e0 = splat64(e[0]), e1 = splat64(e[1]), e2 = splat64(e[2]);
+  uint32_t negative = 0;
+  for (int part = 0; part < 16 / kNative64; ++part) {
+    LN a, b, c;
+    std::memcpy(&a, off + part * kNative64, sizeof(LN));
+    std::memcpy(&b, off + 16 + part * kNative64, sizeof(LN));
+    std::memcpy(&c, off + 32 + part * kNative64, sizeof(LN));
+    negative |= sign_bits64((e0 + a) | (e1 + b) | (e2 + c)) << (part * kNative64);
+  }
+  return ~negative & 0xffffu;
+}
+
 // `e`: the three edge functions at the block's first sample. T is int32_t only where
 // fixed_point.hpp's kSmallTriangleFx8 bound proves every value fits.
 template <class V, class T>
 [[gnu::always_inline]] inline uint32_t coverage_bits(const int64_t e[3], const EdgeOffsets<V>& o) {
+  if constexpr (sizeof(T) == 8) {
+    static_assert(sizeof(o.off) == 3 * 16 * sizeof(int64_t));
+    return coverage_bits_64(e, reinterpret_cast<const int64_t*>(o.off));
+  }
   uint32_t bits = 0;
   for (int g = 0; g < kGroups; ++g) {
     V all = (T(e[0]) + o.off[0][g]) | (T(e[1]) + o.off[1][g]) | (T(e[2]) + o.off[2][g]);
