@@ -484,5 +484,33 @@ TEST(TextureRules, DemoFarFloorMoireEnergyFallsWithMipmaps) {
   EXPECT_LT(e_trilinear, 0.25 * e_bilinear);
 }
 
+// Texture::translucent, which sends a textured surface to the second (blended) pass: a stray
+// transparent texel does not make a picture translucent, a transparent area of one square (16x16
+// texels of a 1024x1024 picture, which has 64x64 such squares) does, and so does an alpha of
+// 200/255 everywhere. The answer is kept, and a copy gives the same.
+TEST(TextureRules, TranslucentCountsAreasNotStrayTexels) {
+  EXPECT_FALSE(Texture().translucent());
+  auto picture = [](int area, uint8_t alpha) {
+    Image image(1024, 1024);
+    for (size_t k = 0; k < image.rgba.size(); k += 4) {
+      image.rgba[k] = 90, image.rgba[k + 1] = 120, image.rgba[k + 2] = 200;
+      image.rgba[k + 3] = 255;
+    }
+    for (int y = 0; y < area; ++y) {
+      for (int x = 0; x < area; ++x) image.pixel(320 + x, 480 + y)[3] = alpha;
+    }
+    return Texture::from_image(image);
+  };
+  EXPECT_FALSE(picture(0, 0).translucent());
+  EXPECT_FALSE(picture(1, 0).translucent());            // one texel: its square's mean is 254
+  EXPECT_TRUE(picture(16, 0).translucent());            // a whole square
+  EXPECT_TRUE(picture(1024 - 480, 200).translucent());  // alpha 200 over the lower rows
+  Texture t = picture(16, 0);
+  EXPECT_TRUE(t.translucent());
+  EXPECT_TRUE(t.translucent());  // the kept answer
+  Texture copy = t;
+  EXPECT_TRUE(copy.translucent());
+}
+
 }  // namespace
 }  // namespace softrast

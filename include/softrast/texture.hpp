@@ -148,8 +148,17 @@ class Texture {
     if (mips_ && !mips_->ready.load(std::memory_order_acquire)) build_mips();
   }
 
+  // Whether the picture lets what is behind it show: the base level is cut into squares, as
+  // small as leaves at least 64x64 of them, and some square's mean alpha is below 250/255 (so a
+  // translucent area of more than a few texels counts and a stray texel does not). Computed on
+  // first use and kept: the built-in shaders ask it in every frame.
+  bool translucent() const;
+
   // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
   static int wrap(Wrap mode, int i, int size);
+  // wrap() of `count` indices in place, index k within sizes[k] (out of line: the wide samplers'
+  // path for sizes that are not powers of two and for mirrored repeat).
+  static void wrap_lanes(Wrap mode, int32_t* indices, const int32_t* sizes, int count);
 
  private:
   glm::vec4 sample_nearest(const Sampler& s, glm::vec2 uv, int level) const;
@@ -187,8 +196,10 @@ class Texture {
   struct MipState {
     std::mutex mutex;
     std::atomic<bool> ready{false};
+    std::atomic<int> translucent{-1};  // translucent(): -1 until computed
   };
   void build_mips() const;
+  bool compute_translucent() const;
   static std::vector<MipLevel> mip_levels(int width, int height);
   void downsample(const MipLevel& from, const MipLevel& to);
   void downsample_srgb(const MipLevel& from, const MipLevel& to);

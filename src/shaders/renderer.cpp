@@ -56,45 +56,12 @@ Surface surface_of(const Mesh& mesh, int material, const RenderOptions& opt) {
   return s;
 }
 
-// Whether a texture has texels that are not opaque, judged by squares of its base level: the
-// mean alpha of each square of 2^L x 2^L texels, where level L is the smallest level of at least
-// 64x64 texels (or the base), so that a translucent area of more than a few texels counts and a
-// stray texel does not. Reads only the base level (the mip chain is built when first sampled).
-bool has_translucent_texels(const Texture& t) {
-  const int w = t.width(), h = t.height();
-  const auto* texels = reinterpret_cast<const uint32_t*>(t.texels());
-  uint32_t lowest = 255;
-  for (size_t k = 0; k < size_t(w) * size_t(h); ++k) lowest = std::min(lowest, texels[k] >> 24);
-  if (lowest >= 250) return false;  // the usual opaque map: one pass over the alpha
-  int level = 0;
-  auto side = [](int n, int l) { return std::max(n >> l, 1); };
-  while ((side(w, level) > 1 || side(h, level) > 1) &&
-         side(w, level + 1) * side(h, level + 1) >= 4096) {
-    ++level;
-  }
-  const int block = 1 << level;
-  for (int by = 0; by < h; by += block) {
-    for (int bx = 0; bx < w; bx += block) {
-      uint64_t sum = 0, count = 0;
-      for (int y = by; y < std::min(h, by + block); ++y) {
-        for (int x = bx; x < std::min(w, bx + block); ++x) {
-          sum += texels[size_t(y) * size_t(w) + size_t(x)] >> 24;
-          ++count;
-        }
-      }
-      if (sum < 250 * count) return true;
-    }
-  }
-  return false;
-}
-
 // Whether a surface lets what is behind it show (phong and texture): a material opacity below
 // 1 (MTL d), an alpha map, or a diffuse map with translucent texels (a cornea over an eye).
 bool translucent(const Surface& s, const RenderOptions& opt) {
-  if (opt.shader == ShaderKind::kTexture) return s.texture && has_translucent_texels(*s.texture);
+  if (opt.shader == ShaderKind::kTexture) return s.texture && s.texture->translucent();
   if (opt.shader != ShaderKind::kPhong) return false;
-  return s.maps.opacity < 1.0f || s.maps.alpha ||
-         (s.maps.diffuse && has_translucent_texels(*s.maps.diffuse));
+  return s.maps.opacity < 1.0f || s.maps.alpha || (s.maps.diffuse && s.maps.diffuse->translucent());
 }
 
 // Whether phong needs the mesh's tangents for `material`: a tangent-space normal map in use.

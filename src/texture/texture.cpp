@@ -183,6 +183,53 @@ Texture Texture::from_mip_levels(const std::vector<Image>& levels, ColorSpace sp
   return texture;
 }
 
+// Whether a texture has texels that are not opaque, judged by squares of its base level: the
+// mean alpha of each square of 2^L x 2^L texels, where level L is the smallest level of at least
+// 64x64 texels (or the base), so that a translucent area of more than a few texels counts and a
+// stray texel does not. Reads only the base level (the mip chain is built when first sampled).
+bool Texture::compute_translucent() const {
+  const Texture& t = *this;
+  const int w = t.width(), h = t.height();
+  const auto* texels = reinterpret_cast<const uint32_t*>(t.texels());
+  uint32_t lowest = 255;
+  for (size_t k = 0; k < size_t(w) * size_t(h); ++k) lowest = std::min(lowest, texels[k] >> 24);
+  if (lowest >= 250) return false;  // the usual opaque map: one pass over the alpha
+  int level = 0;
+  auto side = [](int n, int l) { return std::max(n >> l, 1); };
+  while ((side(w, level) > 1 || side(h, level) > 1) &&
+         side(w, level + 1) * side(h, level + 1) >= 4096) {
+    ++level;
+  }
+  const int block = 1 << level;
+  for (int by = 0; by < h; by += block) {
+    for (int bx = 0; bx < w; bx += block) {
+      uint64_t sum = 0, count = 0;
+      for (int y = by; y < std::min(h, by + block); ++y) {
+        for (int x = bx; x < std::min(w, bx + block); ++x) {
+          sum += texels[size_t(y) * size_t(w) + size_t(x)] >> 24;
+          ++count;
+        }
+      }
+      if (sum < 250 * count) return true;
+    }
+  }
+  return false;
+}
+
+void Texture::wrap_lanes(Wrap mode, int32_t* indices, const int32_t* sizes, int count) {
+  for (int k = 0; k < count; ++k) indices[k] = wrap(mode, indices[k], sizes[k]);
+}
+
+bool Texture::translucent() const {
+  if (!mips_) return false;  // empty: samples as opaque white
+  int known = mips_->translucent.load(std::memory_order_relaxed);
+  if (known < 0) {  // two threads may both compute it: the same answer
+    known = compute_translucent() ? 1 : 0;
+    mips_->translucent.store(known, std::memory_order_relaxed);
+  }
+  return known == 1;
+}
+
 std::vector<MipLevel> Texture::mip_levels(int width, int height) {
   std::vector<MipLevel> levels{{width, height, 0}};
   while (levels.back().width > 1 || levels.back().height > 1) {
