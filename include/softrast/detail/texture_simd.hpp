@@ -40,11 +40,13 @@ SOFTRAST_SIMD_INLINE simd::Int<N> wrap_texel(Wrap mode, const simd::Int<N>& i,
     return simd::select(i < I(0), I(0), simd::select(i > last, last, i));
   }
   if (mode == Wrap::kRepeat && pow2) return i & (size - I(1));
-  I r;  // repeat of other sizes and mirrored repeat: a division per lane, the scalar rule
-  for (int lane = 0; lane < simd::kLanes; ++lane) {
-    r.p[lane / N][lane % N] = Texture::wrap(mode, i.lane(lane), size.lane(lane));
-  }
-  return r;
+  // Repeat of other sizes and mirrored repeat: the scalar rule lane by lane, out of line (inlined
+  // into every sampling site of every shader it made each shader's code several times larger).
+  alignas(64) int32_t lanes[simd::kLanes], sizes[simd::kLanes];
+  i.store(lanes);
+  size.store(sizes);
+  Texture::wrap_lanes(mode, lanes, sizes, simd::kLanes);
+  return I::load(lanes);
 }
 
 // RGBA8 texels to channels in [0, 1]; `decode`: RGB through the sRGB decode table
