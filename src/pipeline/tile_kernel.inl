@@ -103,13 +103,14 @@ template <class V, class T>
   if constexpr (sizeof(T) == 8) {
     static_assert(sizeof(o.off) == 3 * 16 * sizeof(int64_t));
     return coverage_bits_64(e, reinterpret_cast<const int64_t*>(o.off));
+  } else {
+    uint32_t bits = 0;
+    for (int g = 0; g < kGroups; ++g) {
+      V all = (T(e[0]) + o.off[0][g]) | (T(e[1]) + o.off[1][g]) | (T(e[2]) + o.off[2][g]);
+      bits |= lane_bits(__builtin_convertvector(all >= 0, I)) << (g * kLanes);
+    }
+    return bits;
   }
-  uint32_t bits = 0;
-  for (int g = 0; g < kGroups; ++g) {
-    V all = (T(e[0]) + o.off[0][g]) | (T(e[1]) + o.off[1][g]) | (T(e[2]) + o.off[2][g]);
-    bits |= lane_bits(__builtin_convertvector(all >= 0, I)) << (g * kLanes);
-  }
-  return bits;
 }
 
 // ---------------------------------------------------------------------------------------------
