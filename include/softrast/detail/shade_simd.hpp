@@ -261,6 +261,10 @@ SOFTRAST_SIMD_INLINE void shade_block_level(const void* shader, const ShadeTarge
                                             const Interpolants& interp, int x, int y,
                                             uint32_t mask) {
   const S& s = *static_cast<const S*>(shader);
+#if defined(SOFTRAST_SHADERS_BASELINE_ONLY)
+  // The general variant alone (the same results; half the code to build and instrument).
+  shade_block_wide<S, N, false>(s, target, interp, x, y, mask);
+#else
   const RenderState& st = *target.state;
   bool common = !WritesDepth<S> && st.depth_test && st.depth_func == DepthFunc::kLess &&
                 st.depth_write && st.blend == BlendMode::kOpaque;
@@ -269,6 +273,7 @@ SOFTRAST_SIMD_INLINE void shade_block_level(const void* shader, const ShadeTarge
   } else {
     shade_block_wide<S, N, false>(s, target, interp, x, y, mask);
   }
+#endif
 }
 
 // One entry point per SIMD level. `flatten` inlines the shader and everything it calls, so the
@@ -299,10 +304,11 @@ template <class S>
   shade_block_level<S, 16>(shader, target, interp, x, y, mask);
 }
 
-// SOFTRAST_SHADERS_BASELINE_ONLY (the fuzz preset defines it) compiles each shader for the
-// baseline alone: libFuzzer's instrumentation of every shader at four levels made the two files
-// that hold the built-in shaders take most of an hour to build. Shading is then SSE2 at every
-// simd_level(); the tile and vertex kernels still follow it.
+// SOFTRAST_SHADERS_BASELINE_ONLY (the fuzz and sanitizer builds define it) compiles each shader
+// for the baseline alone, in its general variant only: the sanitizers' instrumentation of every
+// shader at four levels made the two files that hold the built-in shaders take most of an hour
+// to build. Shading is then SSE2 at every simd_level(); the tile and vertex kernels still follow
+// it.
 template <class S>
 ShadeBlockFn wide_shade_block([[maybe_unused]] SimdLevel level) {
 #if defined(SOFTRAST_SHADERS_BASELINE_ONLY)
