@@ -158,36 +158,30 @@ SOFTRAST_SIMD_INLINE void level_lanes(const Texture& t, const simd::Int<N>& l, s
   offset = simd::gather<N>(table, at + I(2));
 }
 
-}  // namespace detail
-
-// Samples `texture` at 16 texture coordinates with the sampler's filter and wrap modes; an empty
-// texture samples as opaque white. The same results as Texture::sample, lane by lane.
+// Samples `texture` at 16 texture coordinates with the sampler's filter and wrap modes, inline
+// (the body of the out-of-line kernels below); `texture` is not empty.
 template <int N>
-SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler& s,
-                                          const simd::Vec2<N>& uv) {
-  using F = simd::Float<N>;
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_inline(const Texture& texture, const Sampler& s,
+                                                 const simd::Vec2<N>& uv) {
   using I = simd::Int<N>;
-  if (texture.empty()) return {F(1.0f), F(1.0f), F(1.0f), F(1.0f)};
   const int w = texture.width(), h = texture.height();
-  return detail::sample_level<N>(texture, s, uv, I(w), I(h), I(0), (w & (w - 1)) == 0,
-                                 (h & (h - 1)) == 0, s.filter == Filter::kNearest);
+  return sample_level<N>(texture, s, uv, I(w), I(h), I(0), (w & (w - 1)) == 0,
+                         (h & (h - 1)) == 0, s.filter == Filter::kNearest);
 }
 
-// The same with the texture coordinates' change to the next pixel right and down (for example
-// {f.ddx(uv.x), f.ddx(uv.y)}), which choose the mip levels of Filter::kTrilinear: the same
-// results as Texture::sample(s, uv, duv_dx, duv_dy), lane by lane.
+// The same with derivatives, for a kTrilinear sampler.
 template <int N>
-SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler& s,
-                                          const simd::Vec2<N>& uv, const simd::Vec2<N>& duv_dx,
-                                          const simd::Vec2<N>& duv_dy) {
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_inline(const Texture& texture, const Sampler& s,
+                                                 const simd::Vec2<N>& uv,
+                                                 const simd::Vec2<N>& duv_dx,
+                                                 const simd::Vec2<N>& duv_dy) {
   using F = simd::Float<N>;
   using I = simd::Int<N>;
-  if (texture.empty() || s.filter != Filter::kTrilinear) return sample<N>(texture, s, uv);
   const float w = float(texture.width()), h = float(texture.height());
   F xx = duv_dx.x * F(w), xy = duv_dx.y * F(h), yx = duv_dy.x * F(w), yy = duv_dy.y * F(h);
   F a = xx * xx + xy * xy, b = yx * yx + yy * yy;
   F rho2 = simd::select(a < b, b, a);  // std::max(a, b)
-  F lod = F(0.5f) * detail::fast_log2<N>(rho2);
+  F lod = F(0.5f) * fast_log2<N>(rho2);
   F top(float(texture.levels() - 1));
   I magnify = ~(lod > F(0.0f));  // lod <= 0 or NaN: the base level
   F d = simd::select(magnify, F(0.0f), simd::select(lod < top, lod, top));
@@ -199,15 +193,79 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler&
   bool pow2_u = (tw & (tw - 1)) == 0, pow2_v = (th & (th - 1)) == 0;
   texture.ensure_mips();
   I w0, h0, o0;
-  detail::level_lanes<N>(texture, l0, w0, h0, o0);
-  simd::Vec4<N> c0 = detail::sample_level<N>(texture, s, uv, w0, h0, o0, pow2_u, pow2_v, false);
+  level_lanes<N>(texture, l0, w0, h0, o0);
+  simd::Vec4<N> c0 = sample_level<N>(texture, s, uv, w0, h0, o0, pow2_u, pow2_v, false);
   // No lane between levels (all magnified, or all at the top level): the second level's weight
   // is 0 everywhere, and c0 * 1 + c1 * 0 is c0 exactly (texels are finite), so skip it.
   if (!simd::any(t > F(0.0f))) return c0;
   I w1, h1, o1;
-  detail::level_lanes<N>(texture, l1, w1, h1, o1);
-  simd::Vec4<N> c1 = detail::sample_level<N>(texture, s, uv, w1, h1, o1, pow2_u, pow2_v, false);
-  return detail::lerp<N>(c0, c1, t);
+  level_lanes<N>(texture, l1, w1, h1, o1);
+  simd::Vec4<N> c1 = sample_level<N>(texture, s, uv, w1, h1, o1, pow2_u, pow2_v, false);
+  return lerp<N>(c0, c1, t);
+}
+
+// The lanes of one out-of-line sample, as arrays: coordinates u, v, then (with derivatives)
+// du/dx, dv/dx, du/dy, dv/dy in `in`; red, green, blue, alpha in `out`.
+struct SampleLanes {
+  alignas(64) float in[6][simd::kLanes];
+  alignas(64) float out[4][simd::kLanes];
+};
+
+// The sampler compiled once per SIMD level (src/texture/sample_kernels.cpp), called from the
+// shaders: inlined into every sampling site of every shader, it made most of their code (a
+// phong or pbr block function ran to a megabyte at SSE2) for no speed, since a call per 16
+// pixels costs little next to the gathers. N = 4 is the baseline's (SSE4.2 shaders call it
+// too), 8 needs AVX2 and 16 AVX-512, which is what the shader's level has.
+void sample_lanes_4(const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives);
+void sample_lanes_8(const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives);
+void sample_lanes_16(const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives);
+
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_out_of_line(const Texture& texture, const Sampler& s,
+                                                      SampleLanes& io, bool derivatives) {
+  using F = simd::Float<N>;
+  if constexpr (N == 4) {
+    sample_lanes_4(texture, s, io, derivatives);
+  } else if constexpr (N == 8) {
+    sample_lanes_8(texture, s, io, derivatives);
+  } else {
+    static_assert(N == 16);
+    sample_lanes_16(texture, s, io, derivatives);
+  }
+  return {F::load(io.out[0]), F::load(io.out[1]), F::load(io.out[2]), F::load(io.out[3])};
+}
+
+}  // namespace detail
+
+// Samples `texture` at 16 texture coordinates with the sampler's filter and wrap modes; an empty
+// texture samples as opaque white. The same results as Texture::sample, lane by lane.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler& s,
+                                          const simd::Vec2<N>& uv) {
+  using F = simd::Float<N>;
+  if (texture.empty()) return {F(1.0f), F(1.0f), F(1.0f), F(1.0f)};
+  detail::SampleLanes io;
+  uv.x.store(io.in[0]);
+  uv.y.store(io.in[1]);
+  return detail::sample_out_of_line<N>(texture, s, io, false);
+}
+
+// The same with the texture coordinates' change to the next pixel right and down (for example
+// {f.ddx(uv.x), f.ddx(uv.y)}), which choose the mip levels of Filter::kTrilinear: the same
+// results as Texture::sample(s, uv, duv_dx, duv_dy), lane by lane.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler& s,
+                                          const simd::Vec2<N>& uv, const simd::Vec2<N>& duv_dx,
+                                          const simd::Vec2<N>& duv_dy) {
+  if (texture.empty() || s.filter != Filter::kTrilinear) return sample<N>(texture, s, uv);
+  detail::SampleLanes io;
+  uv.x.store(io.in[0]);
+  uv.y.store(io.in[1]);
+  duv_dx.x.store(io.in[2]);
+  duv_dx.y.store(io.in[3]);
+  duv_dy.x.store(io.in[4]);
+  duv_dy.y.store(io.in[5]);
+  return detail::sample_out_of_line<N>(texture, s, io, true);
 }
 
 }  // namespace softrast
