@@ -14,6 +14,7 @@
 #include "pipeline/multisample_draw.hpp"
 
 #include <algorithm>
+#include <cstddef>
 #include <cstring>
 #include <vector>
 
@@ -27,11 +28,16 @@ namespace softrast::detail {
 namespace {
 
 // Set-up triangles with their interpolants cut short after the last varying
-// (interpolants_bytes), in submission order.
+// (interpolants_bytes), in submission order. Each record starts at a multiple of
+// alignof(Interpolants) (its depth plane is doubles), which UBSan checks.
 class TriangleList {
+  static constexpr size_t kRecordAlign = alignof(Interpolants);
+  static_assert(kRecordAlign % sizeof(float) == 0 && kRecordAlign <= alignof(std::max_align_t));
+
  public:
   explicit TriangleList(int num_varyings)
-      : record_floats_((interpolants_bytes(num_varyings) + sizeof(float) - 1) / sizeof(float)) {}
+      : record_floats_((interpolants_bytes(num_varyings) + kRecordAlign - 1) / kRecordAlign *
+                       kRecordAlign / sizeof(float)) {}
   void add(const SampleTriangle& tri, const Interpolants& interp) {
     coverage_.push_back(tri);
     size_t at = interp_.size();
