@@ -3,9 +3,10 @@
 // path) and by llvmpipe (tools/reference/glconform: every case of a class in one process), and
 // compared by the class's rule:
 //   1. grid: vertices on the 1/256-pixel grid (exact in float, w a power of two): the number
-//      of hits of every pixel is identical (where llvmpipe differs from the exact oracle away
-//      from the edges, llvmpipe is wrong, and softrast must equal the oracle; those pixels are
-//      counted and printed).
+//      of hits of every pixel equals the exact top-left rule's (fill_rule_oracle.hpp; the window
+//      positions are exact, so it decides ties on an edge too). llvmpipe's pixels that differ
+//      from the same rule are counted and printed (Mesa 22.3.6 drops a whole draw of three
+//      triangles when the third is degenerate).
 //   2. float: float vertices with perspective (w in [0.1, 4]): no pixel differs in hits outside
 //      a band of +-1/256 pixel around the edges (the exact edges, computed in double).
 //   3. colour: interpolated colour within 2/255 of a pixel of the other image within one pixel
@@ -55,6 +56,7 @@
 #include <string>
 #include <vector>
 
+#include "fill_rule_oracle.hpp"
 #include "shaders/builtin_shaders.hpp"
 #include "softrast/framebuffer.hpp"
 #include "softrast/image.hpp"
@@ -679,6 +681,29 @@ struct Verdict {
   long llvmpipe_wrong = 0;  // coverage: llvmpipe's pixels that differ from the exact oracle
 };
 
+// Class 1's exact answer: with vertices on the 1/256 grid and w a power of two, the window
+// positions are exact 1/256 multiples, so the top-left rule (fill_rule_oracle.hpp, written from
+// CONVENTIONS.md alone) decides every sample, ties on an edge included: the hits per pixel.
+std::vector<int> fill_rule_counts(const Scene& s) {
+  std::vector<int> count(size_t(s.width) * s.height, 0);
+  for (int p = 0; p < s.primitives(); ++p) {
+    test::Fx8Triangle t;
+    for (int k = 0; k < 3; ++k) {
+      const Vertex& v = s.vertices[size_t(p) * 3 + size_t(k)];
+      double x = (double(v.x) / v.w + 1.0) * 0.5 * s.width;   // exact: see grid_scene
+      double y = (1.0 - double(v.y) / v.w) * 0.5 * s.height;  // y down
+      t.x[size_t(k)] = std::llround(x * 256.0);
+      t.y[size_t(k)] = std::llround(y * 256.0);
+    }
+    for (int y = 0; y < s.height; ++y) {
+      for (int x = 0; x < s.width; ++x) {
+        count[size_t(y) * s.width + x] += test::rule_covers_pixel(t, x, y);
+      }
+    }
+  }
+  return count;
+}
+
 Verdict judge(Rule rule, const Scene& s, const Rendered& soft, const Rendered* gl) {
   Verdict v;
   v.mask.assign(size_t(s.width) * s.height, false);
@@ -689,6 +714,8 @@ Verdict judge(Rule rule, const Scene& s, const Rendered& soft, const Rendered* g
     o = oracle(s);
   }
   if (rule == Rule::kLines) o = line_oracle(s);
+  std::vector<int> exact;
+  if (rule == Rule::kExactHits) exact = fill_rule_counts(s);
   for (int y = 0; y < s.height; ++y) {
     for (int x = 0; x < s.width; ++x) {
       size_t at = size_t(y) * s.width + x;
@@ -699,11 +726,17 @@ Verdict judge(Rule rule, const Scene& s, const Rendered& soft, const Rendered* g
         // (Mesa 22.3.6 drops a whole draw of three triangles when the third is degenerate, a
         // case the grid class found): counted in llvmpipe_wrong, and softrast is held to the
         // oracle there.
-        case Rule::kExactHits:
+        case Rule::kExactHits: {
+          // Every sample against the exact rule, ties included; llvmpipe's differences from it
+          // are counted (at ties where it drew the scene right, the two agree).
+          bad = hits != exact[at];
+          v.llvmpipe_wrong += gl->pixel(x, y)[0] != exact[at];
+          break;
+        }
         case Rule::kHitsOutsideBand: {
           int theirs = gl->pixel(x, y)[0];
           if (o.ambiguous[at]) {
-            bad = rule == Rule::kExactHits && hits != theirs;
+            bad = false;
           } else {
             bad = hits != o.count[at];
             v.llvmpipe_wrong += theirs != o.count[at];
