@@ -106,6 +106,11 @@ Result<json> parse_object(const std::string& text) {
     job = json::parse(text, note_keys);
   } catch (const json::parse_error& e) {
     return Status::error("not valid JSON: " + parse_error_text(e));
+  } catch (const json::out_of_range& e) {  // a number beyond double's range, such as 1e400
+    std::string what = e.what();
+    size_t end = what.find("] ");  // "[json.exception.out_of_range.406] number overflow ..."
+    return Status::error("not valid JSON: " +
+                         (end == std::string::npos ? what : what.substr(end + 2)));
   }
   if (!job.is_object()) return Status::error("a job must be a JSON object {...}");
   if (!twice.empty()) return Status::error("key \"" + twice + "\" is given twice");
