@@ -1,4 +1,5 @@
-// fuzz/cli_args_fuzz.cpp: the render command's argument parsing. The input is split at newlines
+// fuzz/cli_args_fuzz.cpp: the render command's argument parsing, and the batch command's job files
+// (fuzz_batch, at the end). The input is split at newlines
 // into an argument vector (at most 64 arguments), parsed by CLI11 with the CLI's own flag
 // definitions (apps/softrast/args.cpp) the way main.cpp does it (`render` inserted when absent),
 // then checked by interpret() (apps/softrast/setup.cpp). Nothing is loaded or rendered. Every
@@ -11,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "args.hpp"
+#include "batch_jobs.hpp"
 #include "fuzz_entries.hpp"
 #include "setup.hpp"
 #include "softrast/image.hpp"
@@ -70,6 +72,35 @@ int fuzz_cli_args(const uint8_t* data, size_t size) {
     return 0;
   }
   check_spec(*spec);
+  return 0;
+}
+
+int fuzz_batch(const uint8_t* data, size_t size) {
+  std::string content(reinterpret_cast<const char*>(data), size);
+  std::vector<cli::JobLine> lines = cli::split_jobs(content);
+  // The first line doubles as a --defaults object for the others when it is one.
+  std::string defaults = "{}";
+  if (!lines.empty() && cli::check_defaults(lines.front().text).ok()) {
+    defaults = lines.front().text;
+  }
+  size_t previous = 0;
+  for (size_t k = 0; k < lines.size() && k < 32; ++k) {
+    const cli::JobLine& line = lines[k];
+    SOFTRAST_FUZZ_REQUIRE(line.line > previous && line.index == k, "job lines out of order");
+    SOFTRAST_FUZZ_REQUIRE(line.text.find('\n') == std::string::npos, "a job line holds a newline");
+    previous = line.line;
+    Result<cli::JobSpec> spec = cli::interpret_job(line.text, defaults);
+    if (!spec) {
+      const std::string& m = spec.status().message();
+      SOFTRAST_FUZZ_REQUIRE(!m.empty(), "job error without a message");
+      SOFTRAST_FUZZ_REQUIRE(m.find('\n') == std::string::npos, "job error of several lines: " + m);
+      continue;
+    }
+    check_spec(*spec);
+    SOFTRAST_FUZZ_REQUIRE(spec->output.has_value(), "a job without an output image");
+    SOFTRAST_FUZZ_REQUIRE(cli::output_of(line.text).has_value(),
+                          "a job accepted whose line names no output");
+  }
   return 0;
 }
 

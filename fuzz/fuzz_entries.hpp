@@ -42,6 +42,12 @@ int fuzz_image(const uint8_t* data, size_t size);
 // nothing is rendered). Either a usage error with a one-line message or a job within the limits.
 int fuzz_cli_args(const uint8_t* data, size_t size);
 
+// A jobs file of `softrast batch` (one JSON object per line): split into lines, the first taken as
+// the --defaults object when it is a valid one, every line (up to 32) turned into a job by
+// interpret_job (nothing is loaded or rendered). Each line is an error of one line with a message
+// or a job within the limits that names its output image.
+int fuzz_batch(const uint8_t* data, size_t size);
+
 // Raw clip-space geometry (NaN, Inf, huge, denormal, w of either sign) through clipping, setup,
 // rasterization and shading at 32x32 (see geometry_fuzz.cpp for the layout and the checks: no
 // pixel outside the scissor, each triangle's coverage equal to the fill rule's brute-force

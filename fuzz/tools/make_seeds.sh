@@ -13,3 +13,4 @@ find fuzz/corpus -type f | sort | xargs ls -l | awk '{print $5, $9}'
 g++ -std=c++20 -O1 -Iinclude -Itests -o "$out/make_gltf_seeds" fuzz/tools/make_gltf_seeds.cpp \
   build/release/libsoftrast.a $(pkg-config --libs spng stb) -ljpeg -lz -lpthread
 "$out/make_gltf_seeds" fuzz/corpus/gltf
+# fuzz/corpus/batch/seed_*.jsonl (jobs files of `softrast batch`) are written by hand.
