@@ -44,8 +44,8 @@ int fuzz_cli_args(const uint8_t* data, size_t size);
 
 // A jobs file of `softrast batch` (one JSON object per line): split into lines, the first taken as
 // the --defaults object when it is a valid one, every line (up to 32) turned into a job by
-// interpret_job (nothing is loaded or rendered). Each line is an error of one line with a message
-// or a job within the limits that names its output image.
+// interpret_job (nothing is loaded or rendered). Each line is an error with a message or a job
+// within the limits that names its output image.
 int fuzz_batch(const uint8_t* data, size_t size);
 
 // Raw clip-space geometry (NaN, Inf, huge, denormal, w of either sign) through clipping, setup,
