@@ -165,8 +165,8 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_inline(const Texture& texture, const S
                                                  const simd::Vec2<N>& uv) {
   using I = simd::Int<N>;
   const int w = texture.width(), h = texture.height();
-  return sample_level<N>(texture, s, uv, I(w), I(h), I(0), (w & (w - 1)) == 0,
-                         (h & (h - 1)) == 0, s.filter == Filter::kNearest);
+  return sample_level<N>(texture, s, uv, I(w), I(h), I(0), (w & (w - 1)) == 0, (h & (h - 1)) == 0,
+                         s.filter == Filter::kNearest);
 }
 
 // The same with derivatives, for a kTrilinear sampler.
