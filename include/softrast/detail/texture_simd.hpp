@@ -29,6 +29,13 @@ SOFTRAST_SIMD_INLINE simd::Int<N> texel_floor(const simd::Float<N>& x, simd::Flo
   return i;
 }
 
+// floor(x) for |x| < 2^22 (truncation, one down where it went up).
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Float<N> floor_of(const simd::Float<N>& x) {
+  simd::Float<N> t = simd::to_float(simd::to_int(x));
+  return simd::select(t > x, t - simd::Float<N>(1.0f), t);
+}
+
 // Wraps texel indices into [0, size) per lane (sizes may differ by lane: mip levels).
 // `pow2` says every lane's size is a power of two.
 template <int N>
@@ -40,8 +47,20 @@ SOFTRAST_SIMD_INLINE simd::Int<N> wrap_texel(Wrap mode, const simd::Int<N>& i,
     return simd::select(i < I(0), I(0), simd::select(i > last, last, i));
   }
   if (mode == Wrap::kRepeat && pow2) return i & (size - I(1));
-  // Repeat of other sizes and mirrored repeat: the scalar rule lane by lane, out of line (inlined
-  // into every sampling site of every shader it made each shader's code several times larger).
+  // Repeat of other sizes and mirrored repeat: i mod period in float where every |i| < 2^22 (the
+  // quotient's floor is then off by at most one, which the two selects put right; periods are
+  // below 2^16), else the scalar rule lane by lane, out of line (inlined into every sampling site
+  // of every shader it made each shader's code several times larger).
+  const I period = mode == Wrap::kMirroredRepeat ? size + size : size;
+  if (!simd::any((i > I((1 << 22) - 1)) | (i < I(1 - (1 << 22))))) {
+    using F = simd::Float<N>;
+    F p = simd::to_float(period);
+    I m = i - simd::to_int(floor_of<N>(simd::to_float(i) / p)) * period;
+    m = simd::select(m < I(0), m + period, m);
+    m = simd::select(m > period - I(1), m - period, m);
+    if (mode == Wrap::kRepeat) return m;
+    return simd::select(m < size, m, period - I(1) - m);
+  }
   alignas(64) int32_t lanes[simd::kLanes], sizes[simd::kLanes];
   i.store(lanes);
   size.store(sizes);
