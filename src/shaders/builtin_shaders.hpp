@@ -164,12 +164,12 @@ struct PhongShader {
   template <int N>
   SOFTRAST_SIMD_INLINE simd::Vec3<N> normal(const Fragments<N>& f) const {
     using F = simd::Float<N>;
-    simd::Vec3<N> n = simd::normalize(f.vec3(3));
+    simd::Vec3<N> n = simd::normalize_fast(f.vec3(3));
     if (maps.normal) {
       simd::Vec3<N> m =
           map_normal<N>(sample_with_derivatives(*maps.normal, sampler, f, 6), maps.normal_scale);
       if (maps.object_space) {
-        n = simd::normalize(m);
+        n = simd::normalize_fast(m);
       } else if constexpr (kTangents) {
         n = tangent_to_world<N>(m, n, f.vec3(8), f.varying(11));
       }
@@ -182,8 +182,8 @@ struct PhongShader {
     using F = simd::Float<N>;
     simd::Vec3<N> n = normal(f);
     simd::Vec3<N> p = f.vec3(0);
-    simd::Vec3<N> view = simd::normalize(simd::splat3<N>(eye) - p);
-    simd::Vec3<N> l = lighting.point ? simd::normalize(simd::splat3<N>(lighting.position) - p)
+    simd::Vec3<N> view = simd::normalize_fast(simd::splat3<N>(eye) - p);
+    simd::Vec3<N> l = lighting.point ? simd::normalize_fast(simd::splat3<N>(lighting.position) - p)
                                      : simd::splat3<N>(lighting.light);
     LightTerms<N> light = blinn_phong<N>(n, l, view, maps.shininess);
     simd::Vec4<N> base{F(albedo.r), F(albedo.g), F(albedo.b), F(1.0f)};
@@ -215,7 +215,7 @@ struct NormalsShader {
   }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
-    simd::Vec3<N> n = simd::normalize(f.vec3(0)) * simd::Float<N>(0.5f) + simd::Float<N>(0.5f);
+    simd::Vec3<N> n = simd::normalize_fast(f.vec3(0)) * simd::Float<N>(0.5f) + simd::Float<N>(0.5f);
     f.color = {n.x, n.y, n.z, simd::Float<N>(1.0f)};
   }
 };

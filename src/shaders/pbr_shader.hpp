@@ -147,7 +147,7 @@ struct PbrShader {
     using F = simd::Float<N>;
     F nx = f.x * F(2.0f / width) - F(1.0f);
     F ny = F(1.0f) - f.y * F(2.0f / height);
-    return simd::normalize(unproject<N>(nx, ny, -1.0f) - unproject<N>(nx, ny, 1.0f));
+    return simd::normalize_fast(unproject<N>(nx, ny, -1.0f) - unproject<N>(nx, ny, 1.0f));
   }
 
   // The shading normal: the interpolated normal, perturbed by the normal map in the tangent frame
@@ -155,11 +155,11 @@ struct PbrShader {
   template <int N>
   SOFTRAST_SIMD_INLINE simd::Vec3<N> shading_normal(const Fragments<N>& f) const {
     using F = simd::Float<N>;
-    simd::Vec3<N> n = simd::normalize(f.vec3(0));
+    simd::Vec3<N> n = simd::normalize_fast(f.vec3(0));
     if (material->normal_map) {
       simd::Vec4<N> t4 = f.vec4(3);
       simd::Vec3<N> t{t4.x, t4.y, t4.z};
-      t = simd::normalize(t - n * simd::dot(n, t));
+      t = simd::normalize_fast(t - n * simd::dot(n, t));
       F sign = simd::select(t4.w < F(0.0f), F(-1.0f), F(1.0f));
       simd::Vec3<N> b = cross<N>(n, t) * sign;
       simd::Vec4<N> texel = sample_slot(material->normal_map, f);
@@ -222,7 +222,7 @@ struct PbrShader {
 
     // Key light: Cook-Torrance over Lambert.
     V3 l = simd::splat3<N>(light.key_direction);
-    V3 h = simd::normalize(l + v);
+    V3 h = simd::normalize_fast(l + v);
     F n_l = simd::max(simd::dot(n, l), F(0.0f));
     F n_h = simd::max(simd::dot(n, h), F(0.0f));
     F v_h = simd::max(simd::dot(v, h), F(0.0f));

@@ -64,7 +64,7 @@ template <int N>
 SOFTRAST_SIMD_INLINE LightTerms<N> blinn_phong(const simd::Vec3<N>& n, const simd::Vec3<N>& l,
                                                const simd::Vec3<N>& view, float shininess) {
   using F = simd::Float<N>;
-  simd::Vec3<N> h = simd::normalize(l + view);
+  simd::Vec3<N> h = simd::normalize_fast(l + view);
   F d = simd::max(simd::dot(n, l), F(0.0f));
   F nh = simd::max(simd::dot(n, h), F(0.0f));
   F highlight = shininess == 32.0f ? pow32<N>(nh) : fast_pow<N>(nh, shininess);
@@ -109,7 +109,7 @@ SOFTRAST_SIMD_INLINE simd::Vec3<N> tangent_to_world(const simd::Vec3<N>& m, cons
   simd::Int<N> ok = len2 > F(1.0e-20f);
   simd::Vec3<N> tu = to * (F(1.0f) / simd::sqrt(simd::select(ok, len2, F(1.0f))));
   simd::Vec3<N> b = cross<N>(n, tu) * simd::select(w < F(0.0f), F(-1.0f), F(1.0f));
-  simd::Vec3<N> r = simd::normalize(tu * m.x + b * m.y + n * m.z);
+  simd::Vec3<N> r = simd::normalize_fast(tu * m.x + b * m.y + n * m.z);
   return {simd::select(ok, r.x, n.x), simd::select(ok, r.y, n.y), simd::select(ok, r.z, n.z)};
 }
 
