@@ -179,6 +179,92 @@ SOFTRAST_AVX512_FN void bilinear16(const Texture& t, const Sampler& s, SampleLan
   _mm512_store_ps(io.out[3], c.a);
 }
 
+// wrap16 with a size per lane: repeat (of powers of two) or clamp to edge.
+SOFTRAST_AVX512_FN __m512i wrap_levels16(Wrap mode, __m512i i, __m512i size) {
+  __m512i last = _mm512_sub_epi32(size, _mm512_set1_epi32(1));
+  if (mode == Wrap::kRepeat) return _mm512_and_si512(i, last);
+  return _mm512_min_epi32(_mm512_max_epi32(i, _mm512_setzero_si512()), last);
+}
+
+// One mip level per lane (size w x h, first texel `offset`), for trilinear filtering: the same
+// operations as bilinear16 with the sizes as vectors. Each wrap mode is clamp to edge or repeat
+// with power-of-two sizes (every level of such a texture has them).
+SOFTRAST_AVX512_FN Texels16 bilinear_levels16(const Texture& t, const Sampler& s, __m512 u,
+                                              __m512 v, __m512i w, __m512i h, __m512i offset) {
+  __m512 fx, fy;
+  __m512i x0 =
+      floor16(_mm512_sub_ps(_mm512_mul_ps(u, _mm512_cvtepi32_ps(w)), _mm512_set1_ps(0.5f)), fx);
+  __m512i y0 =
+      floor16(_mm512_sub_ps(_mm512_mul_ps(v, _mm512_cvtepi32_ps(h)), _mm512_set1_ps(0.5f)), fy);
+  const __m512i one = _mm512_set1_epi32(1);
+  __m512i i0 = wrap_levels16(s.wrap_u, x0, w);
+  __m512i i1 = wrap_levels16(s.wrap_u, _mm512_add_epi32(x0, one), w);
+  __m512i j0 = wrap_levels16(s.wrap_v, y0, h);
+  __m512i j1 = wrap_levels16(s.wrap_v, _mm512_add_epi32(y0, one), h);
+  __m512i row0 = _mm512_add_epi32(offset, _mm512_mullo_epi32(j0, w));
+  __m512i row1 = _mm512_add_epi32(offset, _mm512_mullo_epi32(j1, w));
+  const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
+  __m512i b0, b1, t0, t1;
+  if (_mm512_cmpneq_epi32_mask(i1, _mm512_add_epi32(i0, one)) == 0) {
+    using V = simd::Native<16>::I;
+    V lo, hi;
+    simd::isa::gather_pair(texels, V(_mm512_add_epi32(row0, i0)), lo, hi);
+    b0 = __m512i(lo), b1 = __m512i(hi);
+    simd::isa::gather_pair(texels, V(_mm512_add_epi32(row1, i0)), lo, hi);
+    t0 = __m512i(lo), t1 = __m512i(hi);
+  } else {
+    b0 = _mm512_i32gather_epi32(_mm512_add_epi32(row0, i0), texels, 4);
+    b1 = _mm512_i32gather_epi32(_mm512_add_epi32(row0, i1), texels, 4);
+    t0 = _mm512_i32gather_epi32(_mm512_add_epi32(row1, i0), texels, 4);
+    t1 = _mm512_i32gather_epi32(_mm512_add_epi32(row1, i1), texels, 4);
+  }
+  return lerp16(lerp16(unpack16(b0), unpack16(b1), fx), lerp16(unpack16(t0), unpack16(t1), fx), fy);
+}
+
+bool trilinear_fast_path(const Texture& t, const Sampler& s) {
+  auto simple = [](Wrap mode, int size) {
+    return mode == Wrap::kClampToEdge || (mode == Wrap::kRepeat && (size & (size - 1)) == 0);
+  };
+  return s.filter == Filter::kTrilinear && !t.decodes(s) && simple(s.wrap_u, t.width()) &&
+         simple(s.wrap_v, t.height());
+}
+
+// sample_inline with derivatives (the level of detail, the two levels and their blend: the same
+// operations), its bilinear lookups through bilinear_levels16.
+SOFTRAST_AVX512_FN void trilinear16(const Texture& texture, const Sampler& s, SampleLanes& io) {
+  using F = simd::Float<16>;
+  using I = simd::Int<16>;
+  const float w = float(texture.width()), h = float(texture.height());
+  F xx = F::load(io.in[2]) * F(w), xy = F::load(io.in[3]) * F(h);
+  F yx = F::load(io.in[4]) * F(w), yy = F::load(io.in[5]) * F(h);
+  F a = xx * xx + xy * xy, b = yx * yx + yy * yy;
+  F rho2 = simd::select(a < b, b, a);
+  F lod = F(0.5f) * fast_log2<16>(rho2);
+  F top(float(texture.levels() - 1));
+  I magnify = ~(lod > F(0.0f));
+  F d = simd::select(magnify, F(0.0f), simd::select(lod < top, lod, top));
+  I l0 = simd::to_int(d);
+  F t = d - simd::to_float(l0);
+  I l1 = simd::select(l0 < simd::to_int(top), l0 + I(1), l0);
+  texture.ensure_mips();
+  const __m512 u = _mm512_load_ps(io.in[0]), v = _mm512_load_ps(io.in[1]);
+  I w0, h0, o0;
+  level_lanes<16>(texture, l0, w0, h0, o0);
+  Texels16 c =
+      bilinear_levels16(texture, s, u, v, __m512i(w0.p[0]), __m512i(h0.p[0]), __m512i(o0.p[0]));
+  if (simd::any(t > F(0.0f))) {  // else every lane's second weight is 0 (sample_inline)
+    I w1, h1, o1;
+    level_lanes<16>(texture, l1, w1, h1, o1);
+    Texels16 c1 =
+        bilinear_levels16(texture, s, u, v, __m512i(w1.p[0]), __m512i(h1.p[0]), __m512i(o1.p[0]));
+    c = lerp16(c, c1, __m512(t.p[0]));
+  }
+  _mm512_store_ps(io.out[0], c.r);
+  _mm512_store_ps(io.out[1], c.g);
+  _mm512_store_ps(io.out[2], c.b);
+  _mm512_store_ps(io.out[3], c.a);
+}
+
 #undef SOFTRAST_AVX512_FN
 #pragma GCC diagnostic pop
 
@@ -194,6 +280,10 @@ SOFTRAST_AVX512_FN void bilinear16(const Texture& t, const Sampler& s, SampleLan
     const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives) {
   if (!derivatives && bilinear_fast_path(texture, s)) {
     bilinear16(texture, s, io);
+    return;
+  }
+  if (derivatives && trilinear_fast_path(texture, s)) {
+    trilinear16(texture, s, io);
     return;
   }
   sample_lanes<16>(texture, s, io, derivatives);
