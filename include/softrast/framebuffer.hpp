@@ -108,11 +108,14 @@ class Framebuffer {
   // from the pixels; clear_color, clear_depth and single-sampled draws reset it, and
   // clear(colour, depth, threads) clears the samples with the pixels. Code that writes pixels
   // directly after a multisampled draw sets it to false too.
+  // The samples are stored tile by tile (64x64 pixels, each pixel's samples together), and a
+  // tile's are filled from its pixels when a draw first touches it (`stale`, one flag per tile).
   struct Multisample {
     int count = 0;
     bool valid = false;
     std::vector<uint32_t> color;
     std::vector<float> depth;
+    std::vector<uint8_t> stale;
   };
   Multisample& multisample() { return multisample_; }
   const Multisample& multisample() const { return multisample_; }

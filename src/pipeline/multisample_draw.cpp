@@ -59,23 +59,41 @@ class TriangleList {
   std::vector<float> interp_;
 };
 
-// Fills the samples from the pixels when they do not hold this sample count's state.
-void prepare_samples(Framebuffer& fb, int count, int threads) {
+// Where the samples of pixel (px, py) start: tile by tile (each tile's 64x64 pixels row by row),
+// so that a tile's samples are one contiguous block that stays in the cache while it is drawn.
+size_t sample_offset(const Framebuffer& fb, int px, int py, int count) {
+  size_t tiles_x = size_t(fb.width() + kTileSize - 1) / kTileSize;
+  size_t tile = size_t(py / kTileSize) * tiles_x + size_t(px / kTileSize);
+  size_t within = size_t(py % kTileSize) * kTileSize + size_t(px % kTileSize);
+  return (tile * size_t(kTileSize) * kTileSize + within) * size_t(count);
+}
+
+// Makes the samples this sample count's: when they do not hold its state, every tile's samples
+// are marked to be filled from the pixels when a draw first touches the tile (fill_samples).
+void prepare_samples(Framebuffer& fb, int count) {
   Framebuffer::Multisample& ms = fb.multisample();
-  size_t pixels = size_t(fb.width()) * size_t(fb.height());
-  if (ms.valid && ms.count == count && ms.color.size() == pixels * size_t(count)) return;
+  size_t tiles = size_t((fb.width() + kTileSize - 1) / kTileSize) *
+                 size_t((fb.height() + kTileSize - 1) / kTileSize);
+  size_t samples = tiles * size_t(kTileSize) * kTileSize * size_t(count);
+  if (ms.valid && ms.count == count && ms.color.size() == samples) return;
   ms.count = count;
-  ms.color.resize(pixels * size_t(count));
-  ms.depth.resize(pixels * size_t(count));
-  parallel_for(size_t(fb.height()), threads, [&](size_t row) {
-    int y = int(row);
-    size_t base = size_t(y) * size_t(fb.width()) * size_t(count);
-    for (int x = 0; x < fb.width(); ++x) {
-      std::fill_n(&ms.color[base + size_t(x) * size_t(count)], count, fb.color_at(x, y));
-      std::fill_n(&ms.depth[base + size_t(x) * size_t(count)], count, fb.depth_at(x, y));
-    }
-  });
+  ms.color.resize(samples);
+  ms.depth.resize(samples);
+  ms.stale.assign(tiles, 1);
   ms.valid = true;
+}
+
+// Fills the samples of the pixels of `rect` (one tile) from the pixels.
+void fill_samples(Framebuffer& fb, const PixelRect& rect) {
+  Framebuffer::Multisample& ms = fb.multisample();
+  const int n = ms.count;
+  for (int y = rect.y0; y < rect.y1; ++y) {
+    for (int x = rect.x0; x < rect.x1; ++x) {
+      size_t at = sample_offset(fb, x, y, n);
+      std::fill_n(&ms.color[at], n, fb.color_at(x, y));
+      std::fill_n(&ms.depth[at], n, fb.depth_at(x, y));
+    }
+  }
 }
 
 // Each pixel of `rect` becomes the average of its samples (per channel, rounded to nearest) and
@@ -86,7 +104,7 @@ void resolve(Framebuffer& fb, const PixelRect& rect) {
   const uint32_t half = uint32_t(n / 2);
   for (int y = rect.y0; y < rect.y1; ++y) {
     for (int x = rect.x0; x < rect.x1; ++x) {
-      size_t at = (size_t(y) * size_t(fb.width()) + size_t(x)) * n;
+      size_t at = sample_offset(fb, x, y, int(n));
       uint32_t sum[4] = {0, 0, 0, 0};
       float depth = ms.depth[at];
       for (size_t s = 0; s < n; ++s) {
@@ -130,7 +148,7 @@ SOFTRAST_AVX512_FN void resolve4(Framebuffer& fb, const PixelRect& rect) {
   for (int y = rect.y0; y < rect.y1; ++y) {
     int x = rect.x0;
     for (; x + kBlockSize <= rect.x1 && (x & (kBlockSize - 1)) == 0; x += kBlockSize) {
-      size_t at = (size_t(y) * size_t(fb.width()) + size_t(x)) * 4;
+      size_t at = sample_offset(fb, x, y, 4);
       __m512i c = _mm512_shuffle_epi8(_mm512_loadu_si512(&ms.color[at]), by_channel);
       __m512i sums = _mm512_madd_epi16(_mm512_maddubs_epi16(c, ones8), ones16);
       __m512i mean = _mm512_srli_epi32(_mm512_add_epi32(sums, half), 2);
@@ -343,7 +361,7 @@ class TileShader {
   }
 
   size_t sample_index(int px, int py) const {
-    return (size_t(py) * size_t(fb_.width()) + size_t(px)) * size_t(pattern_.count);
+    return sample_offset(fb_, px, py, pattern_.count);
   }
 
   Framebuffer& fb_;
@@ -365,7 +383,7 @@ void draw_triangles_multisample(Framebuffer& fb, const GeometryStage& geometry,
                                 const RenderState& state, const FragmentProgram& program,
                                 const uint32_t* indices, size_t index_count, int threads) {
   const SamplePattern& pattern = *standard_sample_pattern(state.samples);
-  prepare_samples(fb, pattern.count, threads);
+  prepare_samples(fb, pattern.count);
 
   // Setup in submission order.
   TriangleList list(geometry.num_varyings());
@@ -409,6 +427,11 @@ void draw_triangles_multisample(Framebuffer& fb, const GeometryStage& geometry,
     PixelRect tile{tx * kTileSize, ty * kTileSize, std::min(fb.width(), (tx + 1) * kTileSize),
                    std::min(fb.height(), (ty + 1) * kTileSize)};
     fb.prepare_tile(tx, ty);  // a pending clear, before the tile's pixels are used as scratch
+    Framebuffer::Multisample& ms = fb.multisample();
+    if (ms.stale[t]) {
+      fill_samples(fb, tile);
+      ms.stale[t] = 0;
+    }
     TileShader shader(fb, state, program, pattern);
     for (uint32_t i : bins[t]) shader.triangle(list.coverage(i), list.interp(i), tile);
     if (pattern.count == 4 && simd_level() >= SimdLevel::kAvx512) {
