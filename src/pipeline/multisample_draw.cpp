@@ -360,9 +360,7 @@ class TileShader {
     }
   }
 
-  size_t sample_index(int px, int py) const {
-    return sample_offset(fb_, px, py, pattern_.count);
-  }
+  size_t sample_index(int px, int py) const { return sample_offset(fb_, px, py, pattern_.count); }
 
   Framebuffer& fb_;
   const RenderState& state_;
