@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <new>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "softrast/shader.hpp"
@@ -125,9 +126,12 @@ TEST(Allocation, SecondFrameOfTheSameSceneAllocatesNothing) {
   }
   detail::ClipVertices vertices{clip.data(), indices.size(), 7, 3};
   Flat shader;
-  for (bool deferrable : {false, true}) {
+  // Single-sampled with and without deferred shading, then 4 samples (its own triangle list, bins
+  // and sample buffers).
+  for (auto [samples, deferrable] : {std::pair{1, false}, {1, true}, {4, false}}) {
     RenderState state;
     state.cull = CullMode::kNone;
+    state.samples = samples;
     detail::FragmentProgram program{&flat_block, &shader, deferrable};
     Framebuffer fb(640, 360);
     auto frame = [&](int threads) {
@@ -139,7 +143,8 @@ TEST(Allocation, SecondFrameOfTheSameSceneAllocatesNothing) {
     // Thread counts alternating, as an application may: the caches serve both.
     long before = g_allocations.load();
     for (int threads : {1, 2, 1}) frame(threads);
-    EXPECT_EQ(g_allocations.load() - before, 0) << "deferrable " << deferrable;
+    EXPECT_EQ(g_allocations.load() - before, 0)
+        << samples << " samples, deferrable " << deferrable;
   }
 }
 

@@ -38,9 +38,13 @@ class TriangleList {
   static_assert(kRecordAlign % sizeof(float) == 0 && kRecordAlign <= alignof(std::max_align_t));
 
  public:
-  explicit TriangleList(int num_varyings)
-      : record_floats_((interpolants_bytes(num_varyings) + kRecordAlign - 1) / kRecordAlign *
-                       kRecordAlign / sizeof(float)) {}
+  // Empties the list for a draw with `num_varyings`, keeping its storage.
+  void reset(int num_varyings) {
+    record_floats_ = (interpolants_bytes(num_varyings) + kRecordAlign - 1) / kRecordAlign *
+                     kRecordAlign / sizeof(float);
+    coverage_.clear();
+    interp_.clear();
+  }
   void add(const SampleTriangle& tri, const Interpolants& interp) {
     coverage_.push_back(tri);
     size_t at = interp_.size();
@@ -54,9 +58,15 @@ class TriangleList {
   }
 
  private:
-  size_t record_floats_;
+  size_t record_floats_ = 0;
   std::vector<SampleTriangle> coverage_;
   std::vector<float> interp_;
+};
+
+struct MultisampleCache {
+  TriangleList list;
+  std::vector<std::vector<uint32_t>> bins;  // per tile: the triangles touching it, in order
+  std::vector<uint32_t> busy;               // the tiles with triangles
 };
 
 // Where the samples of pixel (px, py) start: tile by tile (each tile's 64x64 pixels row by row),
@@ -383,8 +393,12 @@ void draw_triangles_multisample(Framebuffer& fb, const GeometryStage& geometry,
   const SamplePattern& pattern = *standard_sample_pattern(state.samples);
   prepare_samples(fb, pattern.count);
 
-  // Setup in submission order.
-  TriangleList list(geometry.num_varyings());
+  // The triangle records and bins of the calling thread's previous draws, reused: no allocation
+  // per frame once a frame of the same size has been drawn (a million-triangle mesh's records
+  // are 150 MB, which the kernel had to map and clear again every frame).
+  thread_local MultisampleCache cache;
+  TriangleList& list = cache.list;
+  list.reset(geometry.num_varyings());
   auto on_triangle = [&](const WindowVertex& a, const WindowVertex& b, const WindowVertex& c) {
     int64_t area = signed_area_fx16(a, b, c);
     if (area == 0 || is_culled(area, state.cull, state.front_face)) return;
@@ -405,7 +419,9 @@ void draw_triangles_multisample(Framebuffer& fb, const GeometryStage& geometry,
   // Binning: each tile lists the triangles whose bounds touch it, in order.
   const int tiles_x = (fb.width() + kTileSize - 1) / kTileSize;
   const int tiles_y = (fb.height() + kTileSize - 1) / kTileSize;
-  std::vector<std::vector<uint32_t>> bins(size_t(tiles_x) * size_t(tiles_y));
+  std::vector<std::vector<uint32_t>>& bins = cache.bins;
+  bins.resize(size_t(tiles_x) * size_t(tiles_y));
+  for (std::vector<uint32_t>& bin : bins) bin.clear();
   for (size_t t = 0; t < list.size(); ++t) {
     const PixelRect& b = list.coverage(t).bounds;
     for (int ty = b.y0 / kTileSize; ty <= (b.y1 - 1) / kTileSize; ++ty) {
@@ -414,7 +430,8 @@ void draw_triangles_multisample(Framebuffer& fb, const GeometryStage& geometry,
       }
     }
   }
-  std::vector<uint32_t> busy;
+  std::vector<uint32_t>& busy = cache.busy;
+  busy.clear();
   for (size_t i = 0; i < bins.size(); ++i) {
     if (!bins[i].empty()) busy.push_back(uint32_t(i));
   }
