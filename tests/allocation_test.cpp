@@ -143,8 +143,7 @@ TEST(Allocation, SecondFrameOfTheSameSceneAllocatesNothing) {
     // Thread counts alternating, as an application may: the caches serve both.
     long before = g_allocations.load();
     for (int threads : {1, 2, 1}) frame(threads);
-    EXPECT_EQ(g_allocations.load() - before, 0)
-        << samples << " samples, deferrable " << deferrable;
+    EXPECT_EQ(g_allocations.load() - before, 0) << samples << " samples, deferrable " << deferrable;
   }
 }
 
