@@ -1,5 +1,5 @@
-// pipeline/multisample_draw.cpp: multisampled triangles. Setup per triangle on the calling
-// thread, binning into 64x64 tiles, then per tile (in parallel): coverage per sample
+// pipeline/multisample_draw.cpp: multisampled triangles. Setup and binning into 64x64 tiles in
+// chunks of consecutive triangles (in parallel), then per tile (in parallel): coverage per sample
 // (raster/sample_coverage.hpp), the depth test per sample, one run of the fragment program per
 // pixel with a covered sample that passed, its colour blended into those samples, and at the end
 // the tile's pixels resolved from its samples.
@@ -63,10 +63,15 @@ class TriangleList {
   std::vector<float> interp_;
 };
 
-struct MultisampleCache {
+// One chunk of consecutive triangles: their records and, per tile, the ones touching it.
+struct MultisampleChunk {
   TriangleList list;
-  std::vector<std::vector<uint32_t>> bins;  // per tile: the triangles touching it, in order
-  std::vector<uint32_t> busy;               // the tiles with triangles
+  std::vector<std::vector<uint32_t>> bins;
+};
+
+struct MultisampleCache {
+  std::vector<MultisampleChunk> chunks;  // the most any draw used (alternating thread counts)
+  std::vector<uint32_t> busy;            // the tiles with triangles
 };
 
 // Where the samples of pixel (px, py) start: tile by tile (each tile's 64x64 pixels row by row),
@@ -396,44 +401,60 @@ void draw_triangles_multisample(Framebuffer& fb, const GeometryStage& geometry,
   // The triangle records and bins of the calling thread's previous draws, reused: no allocation
   // per frame once a frame of the same size has been drawn (a million-triangle mesh's records
   // are 150 MB, which the kernel had to map and clear again every frame).
-  thread_local MultisampleCache cache;
-  TriangleList& list = cache.list;
-  list.reset(geometry.num_varyings());
-  auto on_triangle = [&](const WindowVertex& a, const WindowVertex& b, const WindowVertex& c) {
-    int64_t area = signed_area_fx16(a, b, c);
-    if (area == 0 || is_culled(area, state.cull, state.front_face)) return;
-    SampleTriangle tri;
-    const WindowVertex* ordered[3];
-    if (!setup_sample_triangle(a, b, c, area, geometry.scissor(), tri, ordered)) return;
-    Interpolants interp;
-    setup_triangle_interpolants(ordered, geometry.num_varyings(), area, state.front_face, interp);
-    list.add(tri, interp);
-  };
-  for (size_t k = 0; k + 2 < index_count; k += 3) {
-    if (geometry.valid(indices[k]) && geometry.valid(indices[k + 1]) &&
-        geometry.valid(indices[k + 2])) {
-      geometry.triangle(indices[k], indices[k + 1], indices[k + 2], on_triangle);
-    }
-  }
-
-  // Binning: each tile lists the triangles whose bounds touch it, in order.
+  thread_local MultisampleCache thread_cache;
+  // A reference, so that the jobs on other threads reach this thread's cache (a thread_local
+  // named inside a lambda would be the running thread's own).
+  MultisampleCache& cache = thread_cache;
   const int tiles_x = (fb.width() + kTileSize - 1) / kTileSize;
   const int tiles_y = (fb.height() + kTileSize - 1) / kTileSize;
-  std::vector<std::vector<uint32_t>>& bins = cache.bins;
-  bins.resize(size_t(tiles_x) * size_t(tiles_y));
-  for (std::vector<uint32_t>& bin : bins) bin.clear();
-  for (size_t t = 0; t < list.size(); ++t) {
-    const PixelRect& b = list.coverage(t).bounds;
-    for (int ty = b.y0 / kTileSize; ty <= (b.y1 - 1) / kTileSize; ++ty) {
-      for (int tx = b.x0 / kTileSize; tx <= (b.x1 - 1) / kTileSize; ++tx) {
-        bins[size_t(ty) * size_t(tiles_x) + size_t(tx)].push_back(uint32_t(t));
+  const size_t tiles = size_t(tiles_x) * size_t(tiles_y);
+
+  // Setup and binning in chunks of consecutive triangles, in parallel; a tile's triangles are its
+  // bins' contents chunk after chunk, which is submission order.
+  const size_t triangles = index_count / 3;
+  const size_t chunks = threads <= 1 ? 1 : std::min<size_t>(size_t(threads) * 4, triangles + 1);
+  if (cache.chunks.size() < chunks) cache.chunks.resize(chunks);
+  const size_t per_chunk = (triangles + chunks - 1) / chunks;
+  parallel_for(chunks, threads, [&](size_t c) {
+    MultisampleChunk& chunk = cache.chunks[c];
+    TriangleList& list = chunk.list;
+    list.reset(geometry.num_varyings());
+    chunk.bins.resize(tiles);
+    for (std::vector<uint32_t>& bin : chunk.bins) bin.clear();
+    auto on_triangle = [&](const WindowVertex& a, const WindowVertex& b, const WindowVertex& c3) {
+      int64_t area = signed_area_fx16(a, b, c3);
+      if (area == 0 || is_culled(area, state.cull, state.front_face)) return;
+      SampleTriangle tri;
+      const WindowVertex* ordered[3];
+      if (!setup_sample_triangle(a, b, c3, area, geometry.scissor(), tri, ordered)) return;
+      Interpolants interp;
+      setup_triangle_interpolants(ordered, geometry.num_varyings(), area, state.front_face, interp);
+      const PixelRect& r = tri.bounds;
+      uint32_t at = uint32_t(list.size());
+      for (int ty = r.y0 / kTileSize; ty <= (r.y1 - 1) / kTileSize; ++ty) {
+        for (int tx = r.x0 / kTileSize; tx <= (r.x1 - 1) / kTileSize; ++tx) {
+          chunk.bins[size_t(ty) * size_t(tiles_x) + size_t(tx)].push_back(at);
+        }
+      }
+      list.add(tri, interp);
+    };
+    size_t end = std::min(triangles, (c + 1) * per_chunk);
+    for (size_t t = std::min(triangles, c * per_chunk); t < end; ++t) {
+      const uint32_t* i = indices + 3 * t;
+      if (geometry.valid(i[0]) && geometry.valid(i[1]) && geometry.valid(i[2])) {
+        geometry.triangle(i[0], i[1], i[2], on_triangle);
       }
     }
-  }
+  });
   std::vector<uint32_t>& busy = cache.busy;
   busy.clear();
-  for (size_t i = 0; i < bins.size(); ++i) {
-    if (!bins[i].empty()) busy.push_back(uint32_t(i));
+  for (size_t t = 0; t < tiles; ++t) {
+    for (size_t c = 0; c < chunks; ++c) {
+      if (!cache.chunks[c].bins[t].empty()) {
+        busy.push_back(uint32_t(t));
+        break;
+      }
+    }
   }
 
   parallel_for(busy.size(), threads, [&](size_t job) {
@@ -448,7 +469,12 @@ void draw_triangles_multisample(Framebuffer& fb, const GeometryStage& geometry,
       ms.stale[t] = 0;
     }
     TileShader shader(fb, state, program, pattern);
-    for (uint32_t i : bins[t]) shader.triangle(list.coverage(i), list.interp(i), tile);
+    for (size_t c = 0; c < chunks; ++c) {
+      const MultisampleChunk& chunk = cache.chunks[c];
+      for (uint32_t i : chunk.bins[t]) {
+        shader.triangle(chunk.list.coverage(i), chunk.list.interp(i), tile);
+      }
+    }
     if (pattern.count == 4 && simd_level() >= SimdLevel::kAvx512) {
       resolve4(fb, tile);
     } else {
