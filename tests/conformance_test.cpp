@@ -64,6 +64,7 @@
 #include "softrast/image.hpp"
 #include "softrast/shader.hpp"
 #include "softrast/texture.hpp"
+#include "texture_oracle.hpp"
 
 namespace softrast {
 namespace {
@@ -544,22 +545,12 @@ int channel_diff(const Rendered& a, int ax, int ay, const Rendered& b, int bx, i
   return worst;
 }
 
-// GL_LINEAR with GL_REPEAT at (u, v) of the base level, in double: the exact bilinear value.
+// GL_LINEAR with GL_REPEAT at (u, v) of the base level, in double: the exact bilinear value
+// (texture_oracle.hpp).
 std::array<double, 4> exact_bilinear(const Texture& t, double u, double v) {
-  const int w = t.width(), h = t.height();
-  double x = u * w - 0.5, y = v * h - 0.5, x0 = std::floor(x), y0 = std::floor(y);
-  double fx = x - x0, fy = y - y0;
-  auto wrap = [](double i, int size) {
-    double m = std::fmod(i, double(size));
-    return int(m < 0 ? m + size : m);
-  };
-  std::array<double, 4> c{};
-  for (int k = 0; k < 4; ++k) {
-    double weight = (k & 1 ? fx : 1.0 - fx) * (k & 2 ? fy : 1.0 - fy);
-    glm::vec4 texel = t.texel(wrap(x0 + (k & 1), w), wrap(y0 + (k >> 1), h));
-    for (int ch = 0; ch < 4; ++ch) c[size_t(ch)] += weight * double(texel[ch]);
-  }
-  return c;
+  auto texel = [&](int i, int j) { return glm::dvec4(t.texel(i, j)); };
+  glm::dvec4 c = test::spec_linear(texel, t.width(), t.height(), Sampler{}, u, v);
+  return {c.r, c.g, c.b, c.a};
 }
 
 bool close_neighbour(const Rendered& a, const Rendered& b, int x, int y, int threshold) {

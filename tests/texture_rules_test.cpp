@@ -20,6 +20,7 @@
 #include "softrast/shader.hpp"
 #include "test_util.hpp"
 #include "texture/srgb_encode.hpp"
+#include "texture_oracle.hpp"
 
 namespace softrast {
 namespace {
@@ -37,39 +38,16 @@ glm::dvec4 texel_of(const Image& image, int i, int j) {
   return glm::dvec4(p[0], p[1], p[2], p[3]) / 255.0;
 }
 
-// The wrap modes as the OpenGL 4.6 specification writes them (8.14.2, table 8.20), for an
-// integer texel coordinate i of a side of `size` texels.
-int spec_wrap(Wrap mode, int64_t i, int64_t size) {
-  auto mod = [](int64_t a, int64_t b) { return ((a % b) + b) % b; };
-  auto mirror = [](int64_t a) { return a >= 0 ? a : -(1 + a); };
-  switch (mode) {
-    case Wrap::kRepeat:
-      return int(mod(i, size));
-    case Wrap::kClampToEdge:
-      return int(std::clamp<int64_t>(i, 0, size - 1));
-    case Wrap::kMirroredRepeat:
-      return int((size - 1) - mirror(mod(i, 2 * size) - size));
-  }
-  return 0;
-}
+using test::spec_wrap;
 
-// GL_NEAREST and GL_LINEAR in double: i = floor(u * w), or the four texels around
-// u * w - 0.5 weighted by the fractions.
+// The specification's GL_NEAREST and GL_LINEAR (texture_oracle.hpp) over an image.
 glm::dvec4 spec_nearest(const Image& image, const Sampler& s, double u, double v) {
-  int i = spec_wrap(s.wrap_u, int64_t(std::floor(u * image.width)), image.width);
-  int j = spec_wrap(s.wrap_v, int64_t(std::floor(v * image.height)), image.height);
-  return texel_of(image, i, j);
+  auto texel = [&](int i, int j) { return texel_of(image, i, j); };
+  return test::spec_nearest(texel, image.width, image.height, s, u, v);
 }
 glm::dvec4 spec_linear(const Image& image, const Sampler& s, double u, double v) {
-  double x = u * image.width - 0.5, y = v * image.height - 0.5;
-  double x0 = std::floor(x), y0 = std::floor(y);
-  double a = x - x0, b = y - y0;
-  int i0 = spec_wrap(s.wrap_u, int64_t(x0), image.width);
-  int i1 = spec_wrap(s.wrap_u, int64_t(x0) + 1, image.width);
-  int j0 = spec_wrap(s.wrap_v, int64_t(y0), image.height);
-  int j1 = spec_wrap(s.wrap_v, int64_t(y0) + 1, image.height);
-  return (1 - a) * (1 - b) * texel_of(image, i0, j0) + a * (1 - b) * texel_of(image, i1, j0) +
-         (1 - a) * b * texel_of(image, i0, j1) + a * b * texel_of(image, i1, j1);
+  auto texel = [&](int i, int j) { return texel_of(image, i, j); };
+  return test::spec_linear(texel, image.width, image.height, s, u, v);
 }
 
 // The wide sampler at 16 coordinates (4-lane vectors, the baseline ISA) against the scalar one.
