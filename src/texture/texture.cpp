@@ -82,11 +82,16 @@ struct SrgbEncoder {
   }
 };
 
+// The one table, built on first use (linear_to_srgb_byte and sRGB mip chains share it).
+const SrgbEncoder& srgb_encoder() {
+  static const SrgbEncoder encoder;
+  return encoder;
+}
+
 }  // namespace
 
 uint8_t linear_to_srgb_byte(float c) {
-  static const SrgbEncoder encoder;
-  return encoder(c);
+  return srgb_encoder()(c);
 }
 
 const float* srgb_decode_table() {
@@ -263,7 +268,7 @@ void Texture::downsample(const MipLevel& from, const MipLevel& to) {
 // minified colour textures (the mean of 0 and 255 is 128, which decodes to 0.22, not 0.5).
 void Texture::downsample_srgb(const MipLevel& from, const MipLevel& to) {
   const float* decode = srgb_decode_table();
-  static const SrgbEncoder encode;
+  const SrgbEncoder& encode = srgb_encoder();
   for (int j = 0; j < to.height; ++j) {
     int j0 = std::min(2 * j, from.height - 1), j1 = std::min(2 * j + 1, from.height - 1);
     for (int i = 0; i < to.width; ++i) {
