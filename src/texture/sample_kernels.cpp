@@ -36,14 +36,13 @@ SOFTRAST_SIMD_INLINE void sample_lanes(const Texture& texture, const Sampler& s,
   sample_lanes<8>(texture, s, io, derivatives);
 }
 
-// The common case, written with AVX-512 instructions directly: bilinear filtering of the base
-// level without sRGB decode, every wrap mode. The arithmetic is sample_level's, the same
-// operations in the same order (so the same bits); the way there is shorter: the floor
+// The common cases, written with AVX-512 instructions directly: bilinear filtering of the base
+// level, and trilinear, without sRGB decode, every wrap mode. The arithmetic is sample_level's,
+// the same operations in the same order (so the same bits); the way there is shorter: the floor
 // instruction in place of texel_floor's truncate, compare and correct, a shift in place of the
-// row multiply, comparisons straight into mask registers, and a vector modulo for repeating sizes
-// that are not powers of two (sample_level wraps those lane by lane, which made a 4x4 block take
-// four times as long). What is left is mostly the filter's float arithmetic: 16 conversions and
-// 36 multiplications or additions per block, on the two ports that execute 512-bit operations.
+// row multiply, comparisons straight into mask registers. What is left is mostly the filter's
+// float arithmetic: 16 conversions and 36 multiplications or additions per block, on the two
+// ports that execute 512-bit operations.
 namespace {
 
 // (Vectors passed by value between these inlined helpers: no ABI crosses here.)
@@ -68,40 +67,12 @@ SOFTRAST_AVX512_FN __m512i floor16(__m512 x, __m512& fraction) {
   return _mm512_cvttps_epi32(whole);
 }
 
-// i mod size in [0, size) (Texture::wrap's repeat), for any size: in double, where i / size is
-// close enough to exact that the floor is off by at most one, which the last two steps put right.
-SOFTRAST_AVX512_FN __m256i modulo8(__m256i i, __m512d size, __m512d inverse) {
-  __m512d d = _mm512_cvtepi32_pd(i);
-  __m512d q =
-      _mm512_roundscale_pd(_mm512_mul_pd(d, inverse), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
-  return _mm512_cvtpd_epi32(_mm512_sub_pd(d, _mm512_mul_pd(q, size)));  // exact: integers < 2^53
-}
-SOFTRAST_AVX512_FN __m512i modulo16(__m512i i, int size) {
-  const __m512d s = _mm512_set1_pd(size), inverse = _mm512_set1_pd(1.0 / size);
-  __m512i r =
-      _mm512_inserti64x4(_mm512_castsi256_si512(modulo8(_mm512_castsi512_si256(i), s, inverse)),
-                         modulo8(_mm512_extracti64x4_epi64(i, 1), s, inverse), 1);
-  const __m512i n = _mm512_set1_epi32(size);
-  r = _mm512_mask_add_epi32(r, _mm512_cmplt_epi32_mask(r, _mm512_setzero_si512()), r, n);
-  return _mm512_mask_sub_epi32(r, _mm512_cmpge_epi32_mask(r, n), r, n);
-}
-
-// Texture::wrap, every mode.
-SOFTRAST_AVX512_FN __m512i wrap16(Wrap mode, __m512i i, int size) {
-  __m512i last = _mm512_set1_epi32(size - 1);
-  switch (mode) {
-    case Wrap::kRepeat:
-      if ((size & (size - 1)) == 0) return _mm512_and_si512(i, last);
-      return modulo16(i, size);
-    case Wrap::kClampToEdge:
-      return _mm512_min_epi32(_mm512_max_epi32(i, _mm512_setzero_si512()), last);
-    case Wrap::kMirroredRepeat: {
-      __m512i m = modulo16(i, 2 * size);
-      __m512i mirrored = _mm512_sub_epi32(_mm512_set1_epi32(2 * size - 1), m);
-      return _mm512_mask_mov_epi32(m, _mm512_cmpgt_epi32_mask(m, last), mirrored);
-    }
-  }
-  return i;
+// wrap_texel (texture_simd.hpp) on native vectors: sizes per lane, every mode.
+SOFTRAST_AVX512_FN __m512i wrap16(Wrap mode, __m512i i, __m512i size, bool pow2) {
+  simd::Int<16> index, sizes;
+  index.p[0] = simd::Native<16>::I(i);
+  sizes.p[0] = simd::Native<16>::I(size);
+  return __m512i(wrap_texel<16>(mode, index, sizes, pow2).p[0]);
 }
 
 // unpack_texel without decode.
@@ -126,34 +97,33 @@ SOFTRAST_AVX512_FN Texels16 lerp16(const Texels16& a, const Texels16& b, __m512 
           mix16(a.a, b.a, s, t)};
 }
 
-bool bilinear_fast_path(const Texture& t, const Sampler& s) {
-  return s.filter != Filter::kNearest && !t.decodes(s);
-}
-
-SOFTRAST_AVX512_FN void bilinear16(const Texture& t, const Sampler& s, SampleLanes& io) {
-  const int w = t.width(), h = t.height();
+// sample_level's bilinear branch for one level per lane (size w x h, first texel `offset`);
+// `row_shift` is log2(w) when every lane has that power-of-two width (the rows start at j << it),
+// else -1 (j * w).
+SOFTRAST_AVX512_FN Texels16 bilinear16(const Texture& t, const Sampler& s, __m512 u, __m512 v,
+                                       __m512i w, __m512i h, __m512i offset, bool pow2_u,
+                                       bool pow2_v, int row_shift) {
   __m512 fx, fy;
   __m512i x0 =
-      floor16(_mm512_sub_ps(_mm512_mul_ps(_mm512_load_ps(io.in[0]), _mm512_set1_ps(float(w))),
-                            _mm512_set1_ps(0.5f)),
-              fx);
+      floor16(_mm512_sub_ps(_mm512_mul_ps(u, _mm512_cvtepi32_ps(w)), _mm512_set1_ps(0.5f)), fx);
   __m512i y0 =
-      floor16(_mm512_sub_ps(_mm512_mul_ps(_mm512_load_ps(io.in[1]), _mm512_set1_ps(float(h))),
-                            _mm512_set1_ps(0.5f)),
-              fy);
+      floor16(_mm512_sub_ps(_mm512_mul_ps(v, _mm512_cvtepi32_ps(h)), _mm512_set1_ps(0.5f)), fy);
   const __m512i one = _mm512_set1_epi32(1);
-  __m512i i0 = wrap16(s.wrap_u, x0, w), i1 = wrap16(s.wrap_u, _mm512_add_epi32(x0, one), w);
-  __m512i j0 = wrap16(s.wrap_v, y0, h), j1 = wrap16(s.wrap_v, _mm512_add_epi32(y0, one), h);
-  // Rows start at j * w: a shift when w is a power of two.
+  __m512i i0 = wrap16(s.wrap_u, x0, w, pow2_u);
+  __m512i i1 = wrap16(s.wrap_u, _mm512_add_epi32(x0, one), w, pow2_u);
+  __m512i j0 = wrap16(s.wrap_v, y0, h, pow2_v);
+  __m512i j1 = wrap16(s.wrap_v, _mm512_add_epi32(y0, one), h, pow2_v);
   __m512i row0, row1;
-  if ((w & (w - 1)) == 0) {
-    const __m128i shift = _mm_cvtsi32_si128(__builtin_ctz(unsigned(w)));
+  if (row_shift >= 0) {
+    const __m128i shift = _mm_cvtsi32_si128(row_shift);
     row0 = _mm512_sll_epi32(j0, shift);
     row1 = _mm512_sll_epi32(j1, shift);
   } else {
-    row0 = _mm512_mullo_epi32(j0, _mm512_set1_epi32(w));
-    row1 = _mm512_mullo_epi32(j1, _mm512_set1_epi32(w));
+    row0 = _mm512_mullo_epi32(j0, w);
+    row1 = _mm512_mullo_epi32(j1, w);
   }
+  row0 = _mm512_add_epi32(offset, row0);
+  row1 = _mm512_add_epi32(offset, row1);
   const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
   __m512i b0, b1, t0, t1;
   if (_mm512_cmpneq_epi32_mask(i1, _mm512_add_epi32(i0, one)) == 0) {
@@ -170,99 +140,49 @@ SOFTRAST_AVX512_FN void bilinear16(const Texture& t, const Sampler& s, SampleLan
     t0 = _mm512_i32gather_epi32(_mm512_add_epi32(row1, i0), texels, 4);
     t1 = _mm512_i32gather_epi32(_mm512_add_epi32(row1, i1), texels, 4);
   }
-  Texels16 bottom = lerp16(unpack16(b0), unpack16(b1), fx);
-  Texels16 top = lerp16(unpack16(t0), unpack16(t1), fx);
-  Texels16 c = lerp16(bottom, top, fy);
-  _mm512_store_ps(io.out[0], c.r);
-  _mm512_store_ps(io.out[1], c.g);
-  _mm512_store_ps(io.out[2], c.b);
-  _mm512_store_ps(io.out[3], c.a);
-}
-
-// wrap16 with a size per lane: repeat (of powers of two) or clamp to edge.
-SOFTRAST_AVX512_FN __m512i wrap_levels16(Wrap mode, __m512i i, __m512i size) {
-  __m512i last = _mm512_sub_epi32(size, _mm512_set1_epi32(1));
-  if (mode == Wrap::kRepeat) return _mm512_and_si512(i, last);
-  return _mm512_min_epi32(_mm512_max_epi32(i, _mm512_setzero_si512()), last);
-}
-
-// One mip level per lane (size w x h, first texel `offset`), for trilinear filtering: the same
-// operations as bilinear16 with the sizes as vectors. Each wrap mode is clamp to edge or repeat
-// with power-of-two sizes (every level of such a texture has them).
-SOFTRAST_AVX512_FN Texels16 bilinear_levels16(const Texture& t, const Sampler& s, __m512 u,
-                                              __m512 v, __m512i w, __m512i h, __m512i offset) {
-  __m512 fx, fy;
-  __m512i x0 =
-      floor16(_mm512_sub_ps(_mm512_mul_ps(u, _mm512_cvtepi32_ps(w)), _mm512_set1_ps(0.5f)), fx);
-  __m512i y0 =
-      floor16(_mm512_sub_ps(_mm512_mul_ps(v, _mm512_cvtepi32_ps(h)), _mm512_set1_ps(0.5f)), fy);
-  const __m512i one = _mm512_set1_epi32(1);
-  __m512i i0 = wrap_levels16(s.wrap_u, x0, w);
-  __m512i i1 = wrap_levels16(s.wrap_u, _mm512_add_epi32(x0, one), w);
-  __m512i j0 = wrap_levels16(s.wrap_v, y0, h);
-  __m512i j1 = wrap_levels16(s.wrap_v, _mm512_add_epi32(y0, one), h);
-  __m512i row0 = _mm512_add_epi32(offset, _mm512_mullo_epi32(j0, w));
-  __m512i row1 = _mm512_add_epi32(offset, _mm512_mullo_epi32(j1, w));
-  const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
-  __m512i b0, b1, t0, t1;
-  if (_mm512_cmpneq_epi32_mask(i1, _mm512_add_epi32(i0, one)) == 0) {
-    using V = simd::Native<16>::I;
-    V lo, hi;
-    simd::isa::gather_pair(texels, V(_mm512_add_epi32(row0, i0)), lo, hi);
-    b0 = __m512i(lo), b1 = __m512i(hi);
-    simd::isa::gather_pair(texels, V(_mm512_add_epi32(row1, i0)), lo, hi);
-    t0 = __m512i(lo), t1 = __m512i(hi);
-  } else {
-    b0 = _mm512_i32gather_epi32(_mm512_add_epi32(row0, i0), texels, 4);
-    b1 = _mm512_i32gather_epi32(_mm512_add_epi32(row0, i1), texels, 4);
-    t0 = _mm512_i32gather_epi32(_mm512_add_epi32(row1, i0), texels, 4);
-    t1 = _mm512_i32gather_epi32(_mm512_add_epi32(row1, i1), texels, 4);
-  }
   return lerp16(lerp16(unpack16(b0), unpack16(b1), fx), lerp16(unpack16(t0), unpack16(t1), fx), fy);
 }
 
-bool trilinear_fast_path(const Texture& t, const Sampler& s) {
-  auto simple = [](Wrap mode, int size) {
-    return mode == Wrap::kClampToEdge || (mode == Wrap::kRepeat && (size & (size - 1)) == 0);
-  };
-  return s.filter == Filter::kTrilinear && !t.decodes(s) && simple(s.wrap_u, t.width()) &&
-         simple(s.wrap_v, t.height());
-}
-
-// sample_inline with derivatives (the level of detail, the two levels and their blend: the same
-// operations), its bilinear lookups through bilinear_levels16.
-SOFTRAST_AVX512_FN void trilinear16(const Texture& texture, const Sampler& s, SampleLanes& io) {
-  using F = simd::Float<16>;
-  using I = simd::Int<16>;
-  const float w = float(texture.width()), h = float(texture.height());
-  F xx = F::load(io.in[2]) * F(w), xy = F::load(io.in[3]) * F(h);
-  F yx = F::load(io.in[4]) * F(w), yy = F::load(io.in[5]) * F(h);
-  F a = xx * xx + xy * xy, b = yx * yx + yy * yy;
-  F rho2 = simd::select(a < b, b, a);
-  F lod = F(0.5f) * fast_log2<16>(rho2);
-  F top(float(texture.levels() - 1));
-  I magnify = ~(lod > F(0.0f));
-  F d = simd::select(magnify, F(0.0f), simd::select(lod < top, lod, top));
-  I l0 = simd::to_int(d);
-  F t = d - simd::to_float(l0);
-  I l1 = simd::select(l0 < simd::to_int(top), l0 + I(1), l0);
-  texture.ensure_mips();
-  const __m512 u = _mm512_load_ps(io.in[0]), v = _mm512_load_ps(io.in[1]);
-  I w0, h0, o0;
-  level_lanes<16>(texture, l0, w0, h0, o0);
-  Texels16 c =
-      bilinear_levels16(texture, s, u, v, __m512i(w0.p[0]), __m512i(h0.p[0]), __m512i(o0.p[0]));
-  if (simd::any(t > F(0.0f))) {  // else every lane's second weight is 0 (sample_inline)
-    I w1, h1, o1;
-    level_lanes<16>(texture, l1, w1, h1, o1);
-    Texels16 c1 =
-        bilinear_levels16(texture, s, u, v, __m512i(w1.p[0]), __m512i(h1.p[0]), __m512i(o1.p[0]));
-    c = lerp16(c, c1, __m512(t.p[0]));
-  }
+SOFTRAST_AVX512_FN void store16(const Texels16& c, SampleLanes& io) {
   _mm512_store_ps(io.out[0], c.r);
   _mm512_store_ps(io.out[1], c.g);
   _mm512_store_ps(io.out[2], c.b);
   _mm512_store_ps(io.out[3], c.a);
+}
+
+// sample_inline, both forms, for bilinear and trilinear samplers without sRGB decode.
+SOFTRAST_AVX512_FN void filtered16(const Texture& texture, const Sampler& s, SampleLanes& io,
+                                   bool derivatives) {
+  const int w = texture.width(), h = texture.height();
+  // Halving a power of two (down to 1) keeps it one, so the base level decides for every level.
+  const bool pow2_u = (w & (w - 1)) == 0, pow2_v = (h & (h - 1)) == 0;
+  const __m512 u = _mm512_load_ps(io.in[0]), v = _mm512_load_ps(io.in[1]);
+  if (!derivatives) {
+    store16(bilinear16(texture, s, u, v, _mm512_set1_epi32(w), _mm512_set1_epi32(h),
+                       _mm512_setzero_si512(), pow2_u, pow2_v,
+                       pow2_u ? __builtin_ctz(unsigned(w)) : -1),
+            io);
+    return;
+  }
+  using F = simd::Float<16>;
+  using I = simd::Int<16>;
+  I l0, l1;
+  F t;
+  trilinear_levels<16>(texture, {F::load(io.in[2]), F::load(io.in[3])},
+                       {F::load(io.in[4]), F::load(io.in[5])}, l0, l1, t);
+  texture.ensure_mips();
+  I w0, h0, o0;
+  level_lanes<16>(texture, l0, w0, h0, o0);
+  Texels16 c = bilinear16(texture, s, u, v, __m512i(w0.p[0]), __m512i(h0.p[0]), __m512i(o0.p[0]),
+                          pow2_u, pow2_v, -1);
+  if (simd::any(t > F(0.0f))) {  // else every lane's second weight is 0 (sample_inline)
+    I w1, h1, o1;
+    level_lanes<16>(texture, l1, w1, h1, o1);
+    Texels16 c1 = bilinear16(texture, s, u, v, __m512i(w1.p[0]), __m512i(h1.p[0]), __m512i(o1.p[0]),
+                             pow2_u, pow2_v, -1);
+    c = lerp16(c, c1, __m512(t.p[0]));
+  }
+  store16(c, io);
 }
 
 #undef SOFTRAST_AVX512_FN
@@ -278,12 +198,9 @@ SOFTRAST_AVX512_FN void trilinear16(const Texture& texture, const Sampler& s, Sa
 #endif
 [[gnu::target("avx512f,avx512bw,avx512dq,avx512vl"), gnu::flatten]] void sample_lanes_16(
     const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives) {
-  if (!derivatives && bilinear_fast_path(texture, s)) {
-    bilinear16(texture, s, io);
-    return;
-  }
-  if (derivatives && trilinear_fast_path(texture, s)) {
-    trilinear16(texture, s, io);
+  // derivatives is set for kTrilinear samplers only (sample()).
+  if (s.filter != Filter::kNearest && !texture.decodes(s)) {
+    filtered16(texture, s, io, derivatives);
     return;
   }
   sample_lanes<16>(texture, s, io, derivatives);

@@ -188,12 +188,12 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_inline(const Texture& texture, const S
                          s.filter == Filter::kNearest);
 }
 
-// The same with derivatives, for a kTrilinear sampler.
+// The two mip levels of each lane and the blend between them (OpenGL's level of detail: log2 of
+// the longer derivative vector in texels of the base level), as Texture::sample computes them.
 template <int N>
-SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_inline(const Texture& texture, const Sampler& s,
-                                                 const simd::Vec2<N>& uv,
-                                                 const simd::Vec2<N>& duv_dx,
-                                                 const simd::Vec2<N>& duv_dy) {
+SOFTRAST_SIMD_INLINE void trilinear_levels(const Texture& texture, const simd::Vec2<N>& duv_dx,
+                                           const simd::Vec2<N>& duv_dy, simd::Int<N>& l0,
+                                           simd::Int<N>& l1, simd::Float<N>& t) {
   using F = simd::Float<N>;
   using I = simd::Int<N>;
   const float w = float(texture.width()), h = float(texture.height());
@@ -204,9 +204,22 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_inline(const Texture& texture, const S
   F top(float(texture.levels() - 1));
   I magnify = ~(lod > F(0.0f));  // lod <= 0 or NaN: the base level
   F d = simd::select(magnify, F(0.0f), simd::select(lod < top, lod, top));
-  I l0 = simd::to_int(d);
-  F t = d - simd::to_float(l0);
-  I l1 = simd::select(l0 < simd::to_int(top), l0 + I(1), l0);
+  l0 = simd::to_int(d);
+  t = d - simd::to_float(l0);
+  l1 = simd::select(l0 < simd::to_int(top), l0 + I(1), l0);
+}
+
+// The same with derivatives, for a kTrilinear sampler.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_inline(const Texture& texture, const Sampler& s,
+                                                 const simd::Vec2<N>& uv,
+                                                 const simd::Vec2<N>& duv_dx,
+                                                 const simd::Vec2<N>& duv_dy) {
+  using F = simd::Float<N>;
+  using I = simd::Int<N>;
+  I l0, l1;
+  F t;
+  trilinear_levels<N>(texture, duv_dx, duv_dy, l0, l1, t);
   // Halving a power of two (down to 1) keeps it one, so the base level decides for every level.
   int tw = texture.width(), th = texture.height();
   bool pow2_u = (tw & (tw - 1)) == 0, pow2_v = (th & (th - 1)) == 0;
