@@ -24,6 +24,7 @@
 #include "raster/sample_coverage.hpp"
 #include "softrast/detail/parallel.hpp"
 #include "softrast/detail/shade_block.hpp"
+#include "softrast/detail/shade_simd.hpp"
 #include "softrast/framebuffer.hpp"
 #include "softrast/simd_level.hpp"
 
@@ -243,11 +244,7 @@ class TileShader {
       if (pass[i]) shade |= 1u << i;
     }
     if (!shade) return;
-    for (uint32_t m = shade; m; m &= m - 1) {
-      int i = __builtin_ctz(m);
-      *fb_.depth_pixel(x + (i & 3), y + (i >> 2)) = -1.0f;
-    }
-    program_.shade_block(program_.shader, scratch_target_, in, x, y, shade);
+    shade_into_pixels(in, x, y, shade);
     for (uint32_t m = shade; m; m &= m - 1) {
       int i = __builtin_ctz(m), px = x + (i & 3), py = y + (i >> 2);
       float shader_depth = *fb_.depth_pixel(px, py);
@@ -312,11 +309,7 @@ class TileShader {
       }
     }
     if (!shade) return;
-    for (uint32_t m = shade; m; m &= m - 1) {
-      int i = __builtin_ctz(m);
-      *fb_.depth_pixel(x + (i & 3), y + (i >> 2)) = -1.0f;
-    }
-    program_.shade_block(program_.shader, scratch_target_, in, x, y, shade);
+    shade_into_pixels(in, x, y, shade);
     for (int r = 0; r < 4; ++r) {
       __mmask16 write = pass[r];
       for (int p = 0; p < 4; ++p) {
@@ -334,33 +327,29 @@ class TileShader {
     }
   }
 
+  // The wide fragment stage's depth_passes (shade_simd.hpp) as a mask register.
   SOFTRAST_AVX512_FN static __mmask16 passes(DepthFunc f, __m512 z, __m512 stored) {
-    switch (f) {
-      case DepthFunc::kNever:
-        return 0;
-      case DepthFunc::kLess:
-        return _mm512_cmp_ps_mask(z, stored, _CMP_LT_OQ);
-      case DepthFunc::kEqual:
-        return _mm512_cmp_ps_mask(z, stored, _CMP_EQ_OQ);
-      case DepthFunc::kLessEqual:
-        return _mm512_cmp_ps_mask(z, stored, _CMP_LE_OQ);
-      case DepthFunc::kGreater:
-        return _mm512_cmp_ps_mask(z, stored, _CMP_GT_OQ);
-      case DepthFunc::kNotEqual:
-        return _mm512_cmp_ps_mask(z, stored, _CMP_NEQ_UQ);
-      case DepthFunc::kGreaterEqual:
-        return _mm512_cmp_ps_mask(z, stored, _CMP_GE_OQ);
-      case DepthFunc::kAlways:
-        return 0xffff;
+    simd::Float<16> a, b;
+    a.p[0] = simd::Native<16>::F(z);
+    b.p[0] = simd::Native<16>::F(stored);
+    return _mm512_movepi32_mask(__m512i(depth_passes<16>(f, a, b).p[0]));
+  }
+
+  // Runs the fragment program over the pixels of `shade` with the pixels as scratch: their depth
+  // set to -1 first, so that afterwards -1 says the shader discarded the pixel.
+  void shade_into_pixels(const Interpolants& in, int x, int y, uint32_t shade) {
+    for (uint32_t m = shade; m; m &= m - 1) {
+      int i = __builtin_ctz(m);
+      *fb_.depth_pixel(x + (i & 3), y + (i >> 2)) = -1.0f;
     }
-    return 0;
+    program_.shade_block(program_.shader, scratch_target_, in, x, y, shade);
   }
 
   void write_samples(int px, int py, uint8_t samples, const float* z, float shader_depth,
                      uint32_t color, Framebuffer::Multisample& ms) const {
     size_t at = sample_index(px, py);
     const bool opaque = state_.blend == BlendMode::kOpaque;
-    glm::vec4 src = opaque ? glm::vec4(0.0f) : unpack_rgba8(color);
+    glm::vec4 src = opaque ? glm::vec4(0.0f) : softrast::unpack_rgba8(color);
     for (int s = 0; s < pattern_.count; ++s) {
       if (!(samples >> s & 1)) continue;
       float depth = program_.writes_depth ? shader_depth : z[s];
