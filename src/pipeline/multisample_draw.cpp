@@ -264,17 +264,12 @@ class TileShader {
     const __m512 off_x = _mm512_broadcast_f32x4(_mm_loadu_ps(offset_x_));
     const __m512 off_y = _mm512_broadcast_f32x4(_mm_loadu_ps(offset_y_));
     const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
-    // dx = float(px) + offset_x - x_ref; the depth plane in double: (a0 + dadx dx) + dady dy.
-    __m512 dx = _mm512_sub_ps(
+    // dx = float(px) + offset_x - x_ref, dy likewise; the depth plane through the wide fragment
+    // stage's eval_plane (in double, as block() computes it).
+    simd::Float<16> dx, dy;
+    dx.p[0] = simd::Native<16>::F(_mm512_sub_ps(
         _mm512_add_ps(_mm512_cvtepi32_ps(_mm512_add_epi32(_mm512_set1_epi32(x), column)), off_x),
-        _mm512_set1_ps(in.x_ref));
-    const __m512d dady = _mm512_set1_pd(in.z.dady);
-    __m512d zx[2];
-    for (int h = 0; h < 2; ++h) {
-      __m256 part = h == 0 ? _mm512_castps512_ps256(dx) : _mm512_extractf32x8_ps(dx, 1);
-      zx[h] = _mm512_add_pd(_mm512_set1_pd(in.z.a0),
-                            _mm512_mul_pd(_mm512_set1_pd(in.z.dadx), _mm512_cvtps_pd(part)));
-    }
+        _mm512_set1_ps(in.x_ref)));
     const bool test = state_.depth_test;
     __m512 z[4];
     __mmask16 pass[4] = {0, 0, 0, 0};
@@ -286,14 +281,9 @@ class TileShader {
       for (int p = 0; p < 4; ++p) {
         if (row >> p & 1) covered |= __mmask16((cov[4 * r + p] & 0xfu) << (4 * p));
       }
-      __m512 dy = _mm512_sub_ps(_mm512_add_ps(_mm512_set1_ps(float(y + r)), off_y),
-                                _mm512_set1_ps(in.y_ref));
-      __m256 half[2];
-      for (int h = 0; h < 2; ++h) {
-        __m256 part = h == 0 ? _mm512_castps512_ps256(dy) : _mm512_extractf32x8_ps(dy, 1);
-        half[h] = _mm512_cvtpd_ps(_mm512_add_pd(zx[h], _mm512_mul_pd(dady, _mm512_cvtps_pd(part))));
-      }
-      __m512 zr = _mm512_insertf32x8(_mm512_castps256_ps512(half[0]), half[1], 1);
+      dy.p[0] = simd::Native<16>::F(_mm512_sub_ps(
+          _mm512_add_ps(_mm512_set1_ps(float(y + r)), off_y), _mm512_set1_ps(in.y_ref)));
+      __m512 zr = __m512(eval_plane<16>(in.z, dx, dy).p[0]);
       // std::clamp(z, 0, 1): z < 0 ? 0 : (1 < z ? 1 : z).
       zr = _mm512_mask_mov_ps(zr, _mm512_cmp_ps_mask(zr, zero, _CMP_LT_OQ), zero);
       zr = _mm512_mask_mov_ps(zr, _mm512_cmp_ps_mask(one, zr, _CMP_LT_OQ), one);
