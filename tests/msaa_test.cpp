@@ -88,6 +88,18 @@ TEST(Msaa, PerSampleCoverageFollowsTheFillRule) {
         for (int bx = 0; bx < 16; bx += 4) {
           uint8_t cov[16] = {};
           uint32_t mask = any ? detail::block_sample_coverage(tri, p, tri.bounds, bx, by, cov) : 0;
+          // The kernel of every SIMD level this CPU has gives the same coverage.
+          for (int level = 0; any && level <= int(simd_level()); ++level) {
+            uint8_t level_cov[16] = {};
+            uint32_t level_mask = detail::block_sample_coverage_kernel(SimdLevel(level))(
+                tri, p, tri.bounds, bx, by, level_cov);
+            ASSERT_EQ(level_mask, mask) << simd_level_name(SimdLevel(level));
+            for (int i = 0; i < 16; ++i) {
+              if (mask >> i & 1) {
+                ASSERT_EQ(level_cov[i], cov[i]) << simd_level_name(SimdLevel(level));
+              }
+            }
+          }
           for (int i = 0; i < 16; ++i) {
             int px = bx + (i & 3), py = by + (i >> 2);
             uint8_t expect = 0;

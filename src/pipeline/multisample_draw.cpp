@@ -198,6 +198,7 @@ class TileShader {
       offset_y_[s] = float(pattern.y[s]) / float(kSubpixelOne);
     }
     fast4_ = fast_path_applies(state, program, pattern);
+    coverage_ = block_sample_coverage_kernel(simd_level());
   }
   static bool fast_path_applies(const RenderState& state, const FragmentProgram& program,
                                 const SamplePattern& pattern) {
@@ -211,7 +212,7 @@ class TileShader {
     for (int y = area.y0 & ~3; y < area.y1; y += kBlockSize) {
       for (int x = area.x0 & ~3; x < area.x1; x += kBlockSize) {
         uint8_t cov[16];
-        uint32_t pixels = block_sample_coverage(tri, pattern_, area, x, y, cov);
+        uint32_t pixels = coverage_(tri, pattern_, area, x, y, cov);
         if (pixels) block(interp, x, y, pixels, cov);
       }
     }
@@ -364,6 +365,7 @@ class TileShader {
   ShadeTarget scratch_target_;
   float offset_x_[kMaxSamples] = {}, offset_y_[kMaxSamples] = {};
   bool fast4_ = false;
+  BlockSampleCoverageFn coverage_ = nullptr;
 };
 
 #undef SOFTRAST_AVX512_FN

@@ -3,9 +3,11 @@
 
 #include <algorithm>
 
-#include <emmintrin.h>  // SSE2: every x86-64 has it
-
 #include "raster/raster.hpp"
+
+// The kernel's 16-lane vectors (sample_coverage_kernel.inl) never cross a function boundary of
+// this file's: GCC's note that their ABI changed with AVX-512 cannot matter.
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace softrast::detail {
 namespace {
@@ -52,29 +54,6 @@ uint32_t area_pixels(const PixelRect& area, int x, int y) {
 static_assert(2 * kSmallTriangleFx8 * (kSmallTriangleFx8 + 5 * kSubpixelOne) + 1 <
                   (int64_t(1) << 31),
               "32-bit sample edge functions overflow");
-
-// Bit c of the result: the sample of column c (value + c * step) passes (>= 0), for one row.
-inline uint32_t row_mask(int32_t value, int32_t step) {
-  __m128i v = _mm_add_epi32(_mm_set1_epi32(value), _mm_set_epi32(3 * step, 2 * step, step, 0));
-  return uint32_t(~_mm_movemask_ps(_mm_castsi128_ps(v))) & 0xfu;
-}
-
-// Coverage masks per sample of the partially covered block at (x, y): bit 4 * row + column of
-// masks[s], for the 32-bit path.
-void sample_masks_small(const SampleTriangle& tri, const SamplePattern& p, int x, int y,
-                        uint32_t masks[kMaxSamples]) {
-  for (int s = 0; s < p.count; ++s) masks[s] = 0xffffu;
-  for (const EdgeFunction& e : tri.edge) {
-    const int32_t step_x = int32_t(e.a * kSubpixelOne), step_y = int32_t(e.b * kSubpixelOne);
-    for (int s = 0; s < p.count; ++s) {
-      int32_t row =
-          int32_t(e.at(int64_t(x) * kSubpixelOne + p.x[s], int64_t(y) * kSubpixelOne + p.y[s]));
-      uint32_t m = 0;
-      for (int r = 0; r < 4; ++r, row += step_y) m |= row_mask(row, step_x) << (4 * r);
-      masks[s] &= m;
-    }
-  }
-}
 
 enum class BlockTest { kOutside, kInside, kPartial };
 
@@ -136,46 +115,51 @@ bool setup_sample_triangle(const WindowVertex& v0, const WindowVertex& v1, const
   return true;
 }
 
+namespace baseline {
+#include "raster/sample_coverage_kernel.inl"
+}  // namespace baseline
+
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#if defined(__clang__)  // clang ignores GCC target pragmas (the fuzz preset builds with it)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#endif
+namespace avx2 {
+#include "raster/sample_coverage_kernel.inl"
+}  // namespace avx2
+#if defined(__clang__)
+#pragma clang attribute pop
+#endif
+#pragma GCC pop_options
+
+#pragma GCC push_options
+#pragma GCC target("avx512f,avx512bw,avx512dq,avx512vl")
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx512f,avx512bw,avx512dq,avx512vl"))), \
+                             apply_to = function)
+#endif
+namespace avx512 {
+#include "raster/sample_coverage_kernel.inl"
+}  // namespace avx512
+#if defined(__clang__)
+#pragma clang attribute pop
+#endif
+#pragma GCC pop_options
+
+BlockSampleCoverageFn block_sample_coverage_kernel(SimdLevel level) {
+  switch (level) {
+    case SimdLevel::kAvx512:
+      return &avx512::block_sample_coverage;
+    case SimdLevel::kAvx2:
+      return &avx2::block_sample_coverage;
+    default:
+      return &baseline::block_sample_coverage;
+  }
+}
+
 uint32_t block_sample_coverage(const SampleTriangle& tri, const SamplePattern& pattern,
                                const PixelRect& area, int x, int y, uint8_t cov[16]) {
-  uint32_t pixels = area_pixels(area, x, y);
-  BlockTest test = pixels ? classify(tri, pattern, x, y) : BlockTest::kOutside;
-  if (test == BlockTest::kOutside) return 0;
-  const uint8_t all = uint8_t((1u << pattern.count) - 1u);
-  if (test == BlockTest::kInside) {
-    for (int i = 0; i < 16; ++i) cov[i] = (pixels >> i & 1) ? all : 0;
-    return pixels;
-  }
-  if (tri.small) {
-    uint32_t masks[kMaxSamples];
-    sample_masks_small(tri, pattern, x, y, masks);
-    uint32_t mask = 0;
-    for (int i = 0; i < 16; ++i) {
-      uint32_t c = 0;
-      for (int s = 0; s < pattern.count; ++s) c |= (masks[s] >> i & 1u) << s;
-      cov[i] = (pixels >> i & 1) ? uint8_t(c) : 0;
-      mask |= uint32_t(cov[i] != 0) << i;
-    }
-    return mask;
-  }
-  for (int i = 0; i < 16; ++i) cov[i] = (pixels >> i & 1) ? all : 0;
-  for (const EdgeFunction& e : tri.edge) {
-    const int64_t step_x = e.a * kSubpixelOne, step_y = e.b * kSubpixelOne;
-    for (int s = 0; s < pattern.count; ++s) {
-      int64_t row =
-          e.at(int64_t(x) * kSubpixelOne + pattern.x[s], int64_t(y) * kSubpixelOne + pattern.y[s]);
-      const uint8_t bit = uint8_t(1u << s);
-      for (int r = 0; r < 4; ++r, row += step_y) {
-        int64_t value = row;
-        for (int c = 0; c < 4; ++c, value += step_x) {
-          if (value < 0) cov[4 * r + c] &= uint8_t(~bit);
-        }
-      }
-    }
-  }
-  uint32_t mask = 0;
-  for (int i = 0; i < 16; ++i) mask |= uint32_t(cov[i] != 0) << i;
-  return mask;
+  return block_sample_coverage_kernel(simd_level())(tri, pattern, area, x, y, cov);
 }
 
 }  // namespace softrast::detail

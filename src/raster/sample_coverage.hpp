@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "raster/setup.hpp"
+#include "softrast/simd_level.hpp"
 
 namespace softrast::detail {
 
@@ -51,5 +52,10 @@ bool setup_sample_triangle(const WindowVertex& v0, const WindowVertex& v1, const
 // one covered sample (bit 4 * row + column), 0 when none.
 uint32_t block_sample_coverage(const SampleTriangle& tri, const SamplePattern& pattern,
                                const PixelRect& area, int x, int y, uint8_t cov[16]);
+// The same, compiled for one SIMD level (the same results at every level): for a caller that
+// picks it once per draw.
+using BlockSampleCoverageFn = uint32_t (*)(const SampleTriangle& tri, const SamplePattern& pattern,
+                                           const PixelRect& area, int x, int y, uint8_t cov[16]);
+BlockSampleCoverageFn block_sample_coverage_kernel(SimdLevel level);
 
 }  // namespace softrast::detail
