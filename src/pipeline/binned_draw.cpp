@@ -51,6 +51,8 @@ constexpr size_t kVerticesPerJob = 8192;
 struct alignas(64) Chunk {
   RecordArena records;
   std::vector<std::vector<uint32_t>> bins;  // per tile: offsets of its records in `records`
+  // Per tile (deferrable draws): the area of its records' bounding boxes clipped to it.
+  std::vector<int64_t> box_area;
 };
 
 // A tile worker's scratch for deferred tiles.
@@ -110,6 +112,7 @@ class BinnedDraw {
     if (cache_.chunks.size() < num_chunks_) cache_.chunks.resize(num_chunks_);
     for (size_t c = 0; c < num_chunks_; ++c) {
       cache_.chunks[c].bins.resize(size_t(tiles_x_) * size_t(tiles_y_));
+      cache_.chunks[c].box_area.resize(deferred_ ? size_t(tiles_x_) * size_t(tiles_y_) : 0);
     }
     if (TileTimes* t = state.tile_times; t && (t->tiles_x != tiles_x_ || t->tiles_y != tiles_y_)) {
       t->tiles_x = tiles_x_;
@@ -156,6 +159,7 @@ class BinnedDraw {
   void setup_chunk(Chunk& chunk, const uint32_t* indices, size_t begin, size_t end) {
     chunk.records.clear();
     for (std::vector<uint32_t>& bin : chunk.bins) bin.clear();
+    std::fill(chunk.box_area.begin(), chunk.box_area.end(), 0);
     auto add = [&](const WindowVertex& a, const WindowVertex& b, const WindowVertex& c) {
       add_triangle(chunk, a, b, c);
     };
@@ -202,6 +206,15 @@ class BinnedDraw {
     int ty0 = bounds.y0 / kTileSize, ty1 = (bounds.y1 - 1) / kTileSize;
     for (int ty = ty0; ty <= ty1; ++ty) {
       for (int tx = tx0; tx <= tx1; ++tx) chunk.bins[size_t(ty) * tiles_x_ + tx].push_back(offset);
+    }
+    if (chunk.box_area.empty()) return;
+    // The bounds lie inside the scissor, so clipped to the tile they are clipped to its region.
+    for (int ty = ty0; ty <= ty1; ++ty) {
+      int64_t h = std::min(bounds.y1, (ty + 1) * kTileSize) - std::max(bounds.y0, ty * kTileSize);
+      for (int tx = tx0; tx <= tx1; ++tx) {
+        int64_t w = std::min(bounds.x1, (tx + 1) * kTileSize) - std::max(bounds.x0, tx * kTileSize);
+        chunk.box_area[size_t(ty) * tiles_x_ + tx] += w * h;
+      }
     }
   }
 
@@ -256,21 +269,17 @@ class BinnedDraw {
   }
 
   // Deferred shading pays for its visibility pass only where triangles overlap: a tile whose
-  // records' bounding boxes, clipped to it, add up to less than kDeferredDepth times its area
+  // records' bounding boxes, clipped to it, add up to at most kDeferredDepth times its area
   // (one layer of a mesh: each triangle's box is about twice its area) is shaded immediately,
-  // which gives the same image (the deferred tests compare the two bit for bit).
+  // which gives the same image (the deferred tests compare the two bit for bit). The sums are
+  // made while binning (Chunk::box_area): reading every record's bounds again here cost a cache
+  // miss per record and tile.
   static constexpr int64_t kDeferredDepth = 3;
   bool worth_deferring(size_t tile) const {
     PixelRect region = tile_region(tile);
-    int64_t budget = kDeferredDepth * int64_t(region.x1 - region.x0) * (region.y1 - region.y0);
-    for (const Chunk& chunk : chunks()) {
-      for (uint32_t offset : chunk.bins[tile]) {
-        PixelRect r = intersect(record(chunk, offset).coverage.bounds, region);
-        budget -= int64_t(r.x1 - r.x0) * (r.y1 - r.y0);
-        if (budget < 0) return true;
-      }
-    }
-    return false;
+    int64_t boxes = 0;
+    for (const Chunk& chunk : chunks()) boxes += chunk.box_area[tile];
+    return boxes > kDeferredDepth * int64_t(region.x1 - region.x0) * (region.y1 - region.y0);
   }
 
   // Phase 2, immediate shading: every block of every triangle goes to the fragment stage as it
