@@ -64,13 +64,18 @@ void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
     Q wx = snap((x_ndc + 1.0) * 0.5 * width, rx);
     Q wy = snap((1.0 - y_ndc) * 0.5 * height, ry);
     D wz = clamp_like_std((z_ndc + 1.0) * 0.5, 0.0, 1.0);
+    // The six fields converted in vectors, then written vertex by vertex.
+    typedef float FN __attribute__((vector_size(4 * kD)));
+    typedef int32_t IN __attribute__((vector_size(4 * kD)));
+    IN xi = __builtin_convertvector(wx, IN), yi = __builtin_convertvector(wy, IN);
+    FN zf = __builtin_convertvector(wz, FN), wf = __builtin_convertvector(inv_w, FN);
+    FN rxf = __builtin_convertvector(rx, FN), ryf = __builtin_convertvector(ry, FN);
+    if (b.depth_bias != 0.0f) {  // geometry_stage.hpp: the depth bias, in float
+      for (int l = 0; l < kD; ++l) zf[l] = std::clamp(zf[l] + b.depth_bias, 0.0f, 1.0f);
+    }
     for (size_t l = 0; l < lanes; ++l) {
       b.codes[i + l] = uint8_t(code[l]);
-      float zf = float(wz[l]);
-      // geometry_stage.hpp: the depth bias, in float.
-      if (b.depth_bias != 0.0f) zf = std::clamp(zf + b.depth_bias, 0.0f, 1.0f);
-      b.window[i + l] = {int32_t(wx[l]),  int32_t(wy[l]), zf,
-                         float(inv_w[l]), float(rx[l]),   float(ry[l])};
+      b.window[i + l] = {xi[l], yi[l], zf[l], wf[l], rxf[l], ryf[l]};
     }
   }
 }
