@@ -87,7 +87,6 @@ void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area
   g.dx2 = to_pixels(v[2]->x - v[0]->x);
   g.dy1 = to_pixels(v[1]->y - v[0]->y);
   g.dy2 = to_pixels(v[2]->y - v[0]->y);
-  g.inv_area2 = double(kSubpixelOne) * kSubpixelOne / double(area_fx16);
   // The exact vertices, relative to the snapped vertex 0 (rx0, ry0: vertex 0's own residual).
   const double rx0 = to_pixels(1) * v[0]->x_residual, ry0 = to_pixels(1) * v[0]->y_residual;
   PlaneBasis e;
@@ -100,7 +99,10 @@ void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area
   bool exact = (rx0 != 0.0 || ry0 != 0.0 || e.dx1 != g.dx1 || e.dx2 != g.dx2 || e.dy1 != g.dy1 ||
                 e.dy2 != g.dy2) &&
                exact_area2 >= snapped_area2 * (1.0 / 16.0);
-  if (exact) e.inv_area2 = 1.0 / exact_area2;
+  // One division, whichever basis is used (the same quotient either way).
+  double inv_area2 = exact ? 1.0 / exact_area2
+                           : double(kSubpixelOne) * kSubpixelOne / double(area_fx16);
+  g.inv_area2 = e.inv_area2 = inv_area2;
   // The exact planes pass through the exact vertex 0, which is (rx0, ry0) from the snapped one.
   const PlaneBasis& basis = exact ? e : g;
   const double ox = exact ? rx0 : 0.0, oy = exact ? ry0 : 0.0;
