@@ -84,6 +84,10 @@ class Framebuffer {
   // Fills tile (tx, ty) (tile units) with the pending clear, if it has one. Distinct tiles may be
   // prepared on different threads at once.
   void prepare_tile(int tx, int ty) { prepare(size_t(ty) * size_t(tiles_x_) + size_t(tx)); }
+  // Whether tile (tx, ty) still has a clear pending (color_at and depth_at then give the clear).
+  bool tile_pending(int tx, int ty) const {
+    return pending(size_t(ty) * size_t(tiles_x_) + size_t(tx));
+  }
   // Fills every tile that still has a clear pending, on `threads` threads (0: every core).
   void write_pending_clears(int threads);
 
@@ -101,7 +105,7 @@ class Framebuffer {
   std::vector<float> depth_values() const;
 
   // Colour and depth per sample for multisampled draws (RenderState::samples > 1), `count`
-  // samples per pixel, pixel (x, y)'s at [(y * width + x) * count, ... + count). Kept between
+  // samples per pixel, each pixel's together (the order is below). Kept between
   // multisampled draws with the same count, so that triangles of different draws sharing an edge
   // blend per sample; every draw leaves the pixels resolved (colour the rounded average of the
   // samples, depth their minimum). `valid` is false until a multisampled draw fills the samples

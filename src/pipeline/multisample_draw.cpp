@@ -102,15 +102,24 @@ void prepare_samples(Framebuffer& fb, int count) {
   ms.valid = true;
 }
 
-// Fills the samples of the pixels of `rect` (one tile) from the pixels.
-void fill_samples(Framebuffer& fb, const PixelRect& rect) {
+// Fills the samples of tile (tx, ty), whose pixels are `rect`, from its pixels: all with the
+// pending clear when it has one (the usual first draw of a frame: one fill of the tile's
+// samples), else pixel by pixel. Before prepare_tile.
+void fill_samples(Framebuffer& fb, int tx, int ty, const PixelRect& rect) {
   Framebuffer::Multisample& ms = fb.multisample();
   const int n = ms.count;
+  if (fb.tile_pending(tx, ty)) {
+    size_t first = sample_offset(fb, rect.x0, rect.y0, n),
+           count = size_t(kTileSize) * kTileSize * n;
+    std::fill_n(&ms.color[first], count, fb.color_at(rect.x0, rect.y0));
+    std::fill_n(&ms.depth[first], count, fb.depth_at(rect.x0, rect.y0));
+    return;
+  }
   for (int y = rect.y0; y < rect.y1; ++y) {
-    for (int x = rect.x0; x < rect.x1; ++x) {
-      size_t at = sample_offset(fb, x, y, n);
-      std::fill_n(&ms.color[at], n, fb.color_at(x, y));
-      std::fill_n(&ms.depth[at], n, fb.depth_at(x, y));
+    size_t at = sample_offset(fb, rect.x0, y, n);  // a row's pixels are consecutive
+    for (int x = rect.x0; x < rect.x1; ++x, at += size_t(n)) {
+      std::fill_n(&ms.color[at], n, *fb.color_pixel(x, y));
+      std::fill_n(&ms.depth[at], n, *fb.depth_pixel(x, y));
     }
   }
 }
@@ -468,12 +477,12 @@ void draw_triangles_multisample(Framebuffer& fb, const GeometryStage& geometry,
     int tx = int(t % uint32_t(tiles_x)), ty = int(t / uint32_t(tiles_x));
     PixelRect tile{tx * kTileSize, ty * kTileSize, std::min(fb.width(), (tx + 1) * kTileSize),
                    std::min(fb.height(), (ty + 1) * kTileSize)};
-    fb.prepare_tile(tx, ty);  // a pending clear, before the tile's pixels are used as scratch
     Framebuffer::Multisample& ms = fb.multisample();
     if (ms.stale[t]) {
-      fill_samples(fb, tile);
+      fill_samples(fb, tx, ty, tile);
       ms.stale[t] = 0;
     }
+    fb.prepare_tile(tx, ty);  // a pending clear, before the tile's pixels are used as scratch
     TileShader shader(fb, state, program, pattern);
     for (size_t c = 0; c < chunks; ++c) {
       const MultisampleChunk& chunk = cache.chunks[c];
