@@ -44,7 +44,6 @@ static_assert(Framebuffer::kTileSize == kTileSize && Framebuffer::kBlockSize == 
 constexpr size_t kBatchTriangles = 32768;
 // Chunks per thread in the geometry phase, for load balance when clipping is uneven.
 constexpr int kChunksPerThread = 4;
-constexpr size_t kVerticesPerJob = 8192;
 
 // Cache-line aligned: each chunk's arena and bins are written by one thread while neighbours are
 // written by others.
@@ -63,8 +62,7 @@ struct DeferredScratch {
 
 // What a draw reuses from the previous draw on the same thread.
 struct DrawCache {
-  std::vector<PackedVertex> window;
-  std::vector<uint8_t> codes;  // GeometryStage::vertex_code
+  WindowVertices vertices;
   std::vector<Chunk> chunks;
   std::vector<std::unique_ptr<DeferredScratch>> scratch;  // per tile worker
 };
@@ -122,7 +120,7 @@ class BinnedDraw {
   }
 
   void draw(const uint32_t* indices, size_t index_count) {
-    transform_vertices();
+    cache_.vertices.transform(geometry_, threads_);
     size_t triangles = index_count / 3;
     for (size_t first = 0; first < triangles; first += kBatchTriangles) {
       size_t count = std::min(kBatchTriangles, triangles - first);
@@ -137,24 +135,6 @@ class BinnedDraw {
   }
 
  private:
-  // Phase 0: outcodes and window positions, once per vertex, several at a time.
-  void transform_vertices() {
-    size_t n = geometry_.vertex_count();
-    cache_.window.resize(n);
-    cache_.codes.resize(n);
-    VertexBatch batch = geometry_.vertex_batch(cache_.codes.data(), cache_.window.data());
-    VertexKernelFn kernel = vertex_kernel(simd_level());
-    size_t jobs = (n + kVerticesPerJob - 1) / kVerticesPerJob;
-    parallel_for(jobs, threads_, [&](size_t job) {
-      kernel(batch, job * kVerticesPerJob, std::min(n, (job + 1) * kVerticesPerJob));
-    });
-  }
-
-  WindowVertex window_vertex(uint32_t i) const {
-    const PackedVertex& p = cache_.window[i];
-    return {p.x, p.y, p.z, p.inv_w, geometry_.varyings(i), p.x_residual, p.y_residual};
-  }
-
   // Phase 1 for one chunk.
   void setup_chunk(Chunk& chunk, const uint32_t* indices, size_t begin, size_t end) {
     chunk.records.clear();
@@ -163,18 +143,7 @@ class BinnedDraw {
     auto add = [&](const WindowVertex& a, const WindowVertex& b, const WindowVertex& c) {
       add_triangle(chunk, a, b, c);
     };
-    static_assert(GeometryStage::kNonFinite < 256, "codes are stored in bytes");
-    const uint8_t* codes = cache_.codes.data();
-    for (size_t t = begin; t < end; ++t) {
-      const uint32_t* i = indices + 3 * t;
-      if (!geometry_.valid(i[0]) || !geometry_.valid(i[1]) || !geometry_.valid(i[2])) continue;
-      uint32_t c0 = codes[i[0]], c1 = codes[i[1]], c2 = codes[i[2]];
-      if ((c0 | c1 | c2) == 0) {  // trivially accepted: no clipping, vertices already in window
-        add_triangle(chunk, window_vertex(i[0]), window_vertex(i[1]), window_vertex(i[2]));
-      } else if (!((c0 | c1 | c2) & GeometryStage::kNonFinite) && !(c0 & c1 & c2)) {
-        geometry_.triangle(i[0], i[1], i[2], add);  // crosses a plane: clip
-      }
-    }
+    for (size_t t = begin; t < end; ++t) cache_.vertices.triangle(geometry_, indices + 3 * t, add);
   }
 
   void add_triangle(Chunk& chunk, const WindowVertex& a, const WindowVertex& b,

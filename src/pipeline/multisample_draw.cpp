@@ -20,7 +20,7 @@
 #include <cstring>
 #include <vector>
 
-#include "pipeline/vertex_kernels.hpp"
+#include "pipeline/draw_internal.hpp"
 #include "raster/raster.hpp"
 #include "raster/sample_coverage.hpp"
 #include "softrast/detail/parallel.hpp"
@@ -74,8 +74,7 @@ struct MultisampleChunk {
 struct MultisampleCache {
   std::vector<MultisampleChunk> chunks;  // the most any draw used (alternating thread counts)
   std::vector<uint32_t> busy;            // the tiles with triangles
-  std::vector<PackedVertex> window;      // per vertex, as the binned draw keeps them
-  std::vector<uint8_t> codes;            // GeometryStage::vertex_code
+  WindowVertices vertices;               // as the binned draw keeps them
 };
 
 // Where the samples of pixel (px, py) start: tile by tile (each tile's 64x64 pixels row by row),
@@ -402,23 +401,8 @@ void draw_triangles_multisample(Framebuffer& fb, const GeometryStage& geometry,
   const int tiles_y = (fb.height() + kTileSize - 1) / kTileSize;
   const size_t tiles = size_t(tiles_x) * size_t(tiles_y);
 
-  // Outcodes and window positions once per vertex, in parallel (vertex_kernels.hpp: the same
-  // values GeometryStage computes per triangle corner).
-  const size_t vertex_count = geometry.vertex_count();
-  cache.window.resize(vertex_count);
-  cache.codes.resize(vertex_count);
-  {
-    VertexBatch batch = geometry.vertex_batch(cache.codes.data(), cache.window.data());
-    VertexKernelFn kernel = vertex_kernel(simd_level());
-    constexpr size_t kPerJob = 8192;
-    parallel_for((vertex_count + kPerJob - 1) / kPerJob, threads, [&](size_t job) {
-      kernel(batch, job * kPerJob, std::min(vertex_count, (job + 1) * kPerJob));
-    });
-  }
-  auto window_vertex = [&](uint32_t i) {
-    const PackedVertex& p = cache.window[i];
-    return WindowVertex{p.x, p.y, p.z, p.inv_w, geometry.varyings(i), p.x_residual, p.y_residual};
-  };
+  // Outcodes and window positions once per vertex, in parallel.
+  cache.vertices.transform(geometry, threads);
 
   // Setup and binning in chunks of consecutive triangles, in parallel; a tile's triangles are its
   // bins' contents chunk after chunk, which is submission order.
@@ -451,14 +435,7 @@ void draw_triangles_multisample(Framebuffer& fb, const GeometryStage& geometry,
     };
     size_t end = std::min(triangles, (c + 1) * per_chunk);
     for (size_t t = std::min(triangles, c * per_chunk); t < end; ++t) {
-      const uint32_t* i = indices + 3 * t;
-      if (!geometry.valid(i[0]) || !geometry.valid(i[1]) || !geometry.valid(i[2])) continue;
-      uint32_t c0 = cache.codes[i[0]], c1 = cache.codes[i[1]], c2 = cache.codes[i[2]];
-      if ((c0 | c1 | c2) == 0) {  // trivially accepted: no clipping
-        on_triangle(window_vertex(i[0]), window_vertex(i[1]), window_vertex(i[2]));
-      } else if (!((c0 | c1 | c2) & GeometryStage::kNonFinite) && !(c0 & c1 & c2)) {
-        geometry.triangle(i[0], i[1], i[2], on_triangle);  // crosses a plane: clip
-      }
+      cache.vertices.triangle(geometry, indices + 3 * t, on_triangle);
     }
   });
   std::vector<uint32_t>& busy = cache.busy;
