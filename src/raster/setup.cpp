@@ -100,8 +100,8 @@ void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area
                 e.dy2 != g.dy2) &&
                exact_area2 >= snapped_area2 * (1.0 / 16.0);
   // One division, whichever basis is used (the same quotient either way).
-  double inv_area2 = exact ? 1.0 / exact_area2
-                           : double(kSubpixelOne) * kSubpixelOne / double(area_fx16);
+  double inv_area2 =
+      exact ? 1.0 / exact_area2 : double(kSubpixelOne) * kSubpixelOne / double(area_fx16);
   g.inv_area2 = e.inv_area2 = inv_area2;
   // The exact planes pass through the exact vertex 0, which is (rx0, ry0) from the snapped one.
   const PlaneBasis& basis = exact ? e : g;
