@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <vector>
@@ -277,6 +278,99 @@ TEST(Deferred, VisiblePixelsAreShadedOnceAndOnlyWhereAllowed) {
     greater.depth_func = DepthFunc::kGreater;
     greater.depth_write = true;
     EXPECT_EQ(count_shaded<ColorShader>(scene, greater), 0);  // nothing beats the clear depth 1
+  }
+}
+
+// ---- Wide shaders: derivatives, depth and facing through both paths. ----
+
+// A wide shader whose colour depends on everything a lane takes from its own primitive: the
+// varyings, their derivatives across the quad (so a helper pixel that took another primitive's
+// values would show), the depth, the facing and the position.
+struct WideProbeShader {
+  static constexpr int kVaryings = 4;
+  const glm::vec4* positions;
+  const glm::vec4* colors;
+  glm::vec4 vertex(uint32_t i, float* v) const {
+    v[0] = colors[i].r, v[1] = colors[i].g, v[2] = colors[i].b, v[3] = colors[i].a;
+    return positions[i];
+  }
+  template <int N>
+  SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
+    using F = simd::Float<N>;
+    F r = f.varying(0) + f.ddx(f.varying(1)) * F(16.0f) + f.x * F(1.0f / 4096.0f);
+    F g = f.varying(1) + f.ddy(f.varying(2)) * F(16.0f) + f.y * F(1.0f / 4096.0f);
+    F b = f.varying(2) * F(0.5f) + f.depth * F(0.5f);
+    F a = f.varying(3) * F(f.front_facing ? 1.0f : 0.5f);
+    f.color = {r, g, b, a};
+  }
+};
+
+// A layer of small triangles on a grid (cells of about 7 x 7 pixels at 301 x 187), at varying
+// depth and w, every other cell wound the other way (both facings); optionally under a few large
+// triangles that cross it.
+Scene small_triangle_scene(bool with_large, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  Scene scene;
+  constexpr int kColumns = 40, kRows = 26;
+  auto corner = [&](int i, int j) {
+    float w = 0.8f + 0.4f * float(i + j) / float(kColumns + kRows);
+    float x = -1.0f + 2.0f * float(i) / kColumns, y = -1.0f + 2.0f * float(j) / kRows;
+    float z = -0.2f + 0.3f * std::sin(float(i) * 0.7f) * std::cos(float(j) * 0.4f);
+    return glm::vec4(x * w, y * w, z * w, w);
+  };
+  for (int j = 0; j < kRows; ++j) {
+    for (int i = 0; i < kColumns; ++i) {
+      glm::vec4 color(unit(rng), unit(rng), unit(rng), 1.0f);
+      glm::vec4 a = corner(i, j), b = corner(i + 1, j), c = corner(i + 1, j + 1),
+                d = corner(i, j + 1);
+      if ((i + j) % 2) {
+        scene.triangle(a, b, c, color);
+        scene.triangle(a, c, d, color * 0.7f);
+      } else {
+        scene.triangle(a, c, b, color);
+        scene.triangle(a, d, c, color * 0.7f);
+      }
+    }
+  }
+  if (with_large) {
+    Scene large = overdraw_scene(6, seed + 1, false);
+    for (size_t i = 0; i < large.positions.size(); i += 3) {
+      scene.triangle(large.positions[i], large.positions[i + 1], large.positions[i + 2],
+                     large.colors[i]);
+    }
+  }
+  return scene;
+}
+
+Buffers render_wide(const Scene& scene, RenderState state, int threads, bool reference) {
+  Framebuffer fb(301, 187);
+  state.threads = threads;
+  state.reference_path = reference;
+  WideProbeShader shader{scene.positions.data(), scene.colors.data()};
+  draw(fb, state, shader, scene.indices, uint32_t(scene.positions.size()));
+  return read_back(fb);
+}
+
+// Small triangles of both facings, alone (immediate tiles) and under large ones (deferred tiles),
+// against the reference path, bit for bit, at every level and on 1 and 2 threads.
+TEST(Deferred, WideShaderWithDerivativesEqualsReference) {
+  for (bool with_large : {false, true}) {
+    Scene scene = small_triangle_scene(with_large, 7);
+    for (DepthFunc func : {DepthFunc::kLess, DepthFunc::kLessEqual}) {
+      RenderState state = opaque_state(func);
+      Buffers reference = render_wide(scene, state, 1, true);
+      SimdLevel cap = simd_level();
+      for (int level = 0; level <= int(cap); ++level) {
+        set_simd_level(SimdLevel(level));
+        for (int threads : {1, 2}) {
+          EXPECT_TRUE(render_wide(scene, state, threads, false) == reference)
+              << (with_large ? "with large triangles" : "one layer") << ", threads " << threads
+              << ", " << simd_level_name(SimdLevel(level));
+        }
+      }
+      set_simd_level(cap);
+    }
   }
 }
 
