@@ -3,6 +3,8 @@
 // time from simd_level(), so the binary runs on any x86-64.
 #include "pipeline/tile_kernels.hpp"
 
+#include "core/isa_target.hpp"
+
 #include <immintrin.h>
 
 #include <algorithm>
@@ -16,41 +18,21 @@ namespace sse2 {
 #undef SOFTRAST_LANES
 }  // namespace sse2
 
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#if defined(__clang__)  // clang ignores GCC target pragmas (the fuzz preset builds with it)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
-#endif
+SOFTRAST_TARGET_BEGIN_AVX2
 namespace avx2 {
 #define SOFTRAST_LANES 8
 #include "pipeline/tile_kernel.inl"
 #undef SOFTRAST_LANES
 }  // namespace avx2
-#if defined(__clang__)
-#pragma clang attribute pop
-#endif
-#pragma GCC pop_options
+SOFTRAST_TARGET_END
 
-#pragma GCC push_options
-#pragma GCC target("avx512f,avx512bw,avx512dq,avx512vl")
-#if defined(__clang__)  // clang ignores GCC target pragmas (the fuzz preset builds with it)
-#pragma clang attribute push(__attribute__((target("avx512f,avx512bw,avx512dq,avx512vl"))), \
-                             apply_to = function)
-#endif
-// GCC 12's _mm512_undefined_ps initialises a variable with itself and -Wmaybe-uninitialized
-// reports it inside every AVX-512 min/max (GCC bug 105593, fixed in GCC 13).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+SOFTRAST_TARGET_BEGIN_AVX512
 namespace avx512 {
 #define SOFTRAST_LANES 16
 #include "pipeline/tile_kernel.inl"
 #undef SOFTRAST_LANES
 }  // namespace avx512
-#pragma GCC diagnostic pop
-#if defined(__clang__)
-#pragma clang attribute pop
-#endif
-#pragma GCC pop_options
+SOFTRAST_TARGET_END
 
 TileKernels tile_kernels(SimdLevel level) {
   switch (level) {

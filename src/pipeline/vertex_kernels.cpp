@@ -2,6 +2,8 @@
 // picked at run time.
 #include "pipeline/vertex_kernels.hpp"
 
+#include "core/isa_target.hpp"
+
 #include <immintrin.h>
 
 #include <algorithm>
@@ -18,39 +20,21 @@ namespace sse2 {
 #undef SOFTRAST_DOUBLES
 }  // namespace sse2
 
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#if defined(__clang__)  // clang ignores GCC target pragmas (the fuzz preset builds with it)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
-#endif
+SOFTRAST_TARGET_BEGIN_AVX2
 namespace avx2 {
 #define SOFTRAST_DOUBLES 4
 #include "pipeline/vertex_kernel.inl"
 #undef SOFTRAST_DOUBLES
 }  // namespace avx2
-#if defined(__clang__)
-#pragma clang attribute pop
-#endif
-#pragma GCC pop_options
+SOFTRAST_TARGET_END
 
-#pragma GCC push_options
-#pragma GCC target("avx512f,avx512bw,avx512dq,avx512vl")
-#if defined(__clang__)  // clang ignores GCC target pragmas (the fuzz preset builds with it)
-#pragma clang attribute push(__attribute__((target("avx512f,avx512bw,avx512dq,avx512vl"))), \
-                             apply_to = function)
-#endif
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC bug 105593, see tile_kernels.cpp
+SOFTRAST_TARGET_BEGIN_AVX512
 namespace avx512 {
 #define SOFTRAST_DOUBLES 8
 #include "pipeline/vertex_kernel.inl"
 #undef SOFTRAST_DOUBLES
 }  // namespace avx512
-#pragma GCC diagnostic pop
-#if defined(__clang__)
-#pragma clang attribute pop
-#endif
-#pragma GCC pop_options
+SOFTRAST_TARGET_END
 
 VertexKernelFn vertex_kernel(SimdLevel level) {
   switch (level) {

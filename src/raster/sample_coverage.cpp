@@ -1,6 +1,8 @@
 // raster/sample_coverage.cpp: the standard sample patterns and the per-sample coverage kernel.
 #include "raster/sample_coverage.hpp"
 
+#include "core/isa_target.hpp"
+
 #include <algorithm>
 
 #include "raster/raster.hpp"
@@ -119,32 +121,17 @@ namespace baseline {
 #include "raster/sample_coverage_kernel.inl"
 }  // namespace baseline
 
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#if defined(__clang__)  // clang ignores GCC target pragmas (the fuzz preset builds with it)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
-#endif
+SOFTRAST_TARGET_BEGIN_AVX2
 namespace avx2 {
 #include "raster/sample_coverage_kernel.inl"
 }  // namespace avx2
-#if defined(__clang__)
-#pragma clang attribute pop
-#endif
-#pragma GCC pop_options
+SOFTRAST_TARGET_END
 
-#pragma GCC push_options
-#pragma GCC target("avx512f,avx512bw,avx512dq,avx512vl")
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx512f,avx512bw,avx512dq,avx512vl"))), \
-                             apply_to = function)
-#endif
+SOFTRAST_TARGET_BEGIN_AVX512
 namespace avx512 {
 #include "raster/sample_coverage_kernel.inl"
 }  // namespace avx512
-#if defined(__clang__)
-#pragma clang attribute pop
-#endif
-#pragma GCC pop_options
+SOFTRAST_TARGET_END
 
 BlockSampleCoverageFn block_sample_coverage_kernel(SimdLevel level) {
   switch (level) {
