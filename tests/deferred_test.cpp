@@ -285,15 +285,9 @@ TEST(Deferred, VisiblePixelsAreShadedOnceAndOnlyWhereAllowed) {
 
 // A wide shader whose colour depends on everything a lane takes from its own primitive: the
 // varyings, their derivatives across the quad (so a helper pixel that took another primitive's
-// values would show), the depth, the facing and the position.
-struct WideProbeShader {
-  static constexpr int kVaryings = 4;
-  const glm::vec4* positions;
-  const glm::vec4* colors;
-  glm::vec4 vertex(uint32_t i, float* v) const {
-    v[0] = colors[i].r, v[1] = colors[i].g, v[2] = colors[i].b, v[3] = colors[i].a;
-    return positions[i];
-  }
+// values would show), the depth, the facing and the position. ColorShader's vertex stage; the
+// wide fragment stage is the one draw() picks.
+struct WideProbeShader : ColorShader {
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     using F = simd::Float<N>;
@@ -347,7 +341,9 @@ Buffers render_wide(const Scene& scene, RenderState state, int threads, bool ref
   Framebuffer fb(301, 187);
   state.threads = threads;
   state.reference_path = reference;
-  WideProbeShader shader{scene.positions.data(), scene.colors.data()};
+  WideProbeShader shader;
+  shader.positions = scene.positions.data();
+  shader.colors = scene.colors.data();
   draw(fb, state, shader, scene.indices, uint32_t(scene.positions.size()));
   return read_back(fb);
 }
