@@ -133,13 +133,21 @@ struct SurfaceMaps {
   float opacity = 1.0f;
 };
 
+// What a Phong draw interpolates besides world position and normal: nothing (no maps), the
+// texture coordinates (maps), or those and the tangent frame (a tangent-space normal map).
+enum class PhongInputs { kPlain, kUv, kTangentFrame };
+
 // Blinn-Phong per pixel with a material's maps: albedo from the diffuse map, specular colour
 // times the specular map, the normal from a normal map (object space, or tangent space with
-// the tangent frame interpolated: kTangents, 4 more varyings), one directional or point light.
-// Without maps and with SCENES.md's values it computes exactly what it always has.
-template <bool kTangents>
+// the tangent frame interpolated: 4 more varyings), one directional or point light.
+// Without maps and with SCENES.md's values it computes exactly what it always has. kPlain
+// leaves out the texture coordinates that no map reads: two planes less to set up per triangle
+// and to interpolate per block, the same image.
+template <PhongInputs kInputs>
 struct PhongShader {
-  static constexpr int kVaryings = kTangents ? 12 : 8;  // world position, normal, uv (tangent)
+  static constexpr bool kUv = kInputs != PhongInputs::kPlain;
+  static constexpr bool kTangents = kInputs == PhongInputs::kTangentFrame;
+  static constexpr int kVaryings = kTangents ? 12 : kUv ? 8 : 6;  // position, normal (uv, tangent)
   MeshInputs in;
   glm::vec3 albedo;
   SurfaceMaps maps;
@@ -150,9 +158,11 @@ struct PhongShader {
   glm::vec4 vertex(uint32_t i, float* v) const {
     const glm::vec3& p = in.mesh->positions[i];
     const glm::vec3& n = in.mesh->normals[i];
-    const glm::vec2& uv = in.mesh->uvs[i];
-    v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = n.x, v[4] = n.y, v[5] = n.z, v[6] = uv.x,
-    v[7] = uv.y;
+    v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = n.x, v[4] = n.y, v[5] = n.z;
+    if constexpr (kUv) {
+      const glm::vec2& uv = in.mesh->uvs[i];
+      v[6] = uv.x, v[7] = uv.y;
+    }
     if constexpr (kTangents) {
       const glm::vec4& t = in.mesh->tangents[i];
       v[8] = t.x, v[9] = t.y, v[10] = t.z, v[11] = t.w;
@@ -165,13 +175,15 @@ struct PhongShader {
   SOFTRAST_SIMD_INLINE simd::Vec3<N> normal(const Fragments<N>& f) const {
     using F = simd::Float<N>;
     simd::Vec3<N> n = simd::normalize_fast(f.vec3(3));
-    if (maps.normal) {
-      simd::Vec3<N> m =
-          map_normal<N>(sample_with_derivatives(*maps.normal, sampler, f, 6), maps.normal_scale);
-      if (maps.object_space) {
-        n = simd::normalize_fast(m);
-      } else if constexpr (kTangents) {
-        n = tangent_to_world<N>(m, n, f.vec3(8), f.varying(11));
+    if constexpr (kUv) {
+      if (maps.normal) {
+        simd::Vec3<N> m =
+            map_normal<N>(sample_with_derivatives(*maps.normal, sampler, f, 6), maps.normal_scale);
+        if (maps.object_space) {
+          n = simd::normalize_fast(m);
+        } else if constexpr (kTangents) {
+          n = tangent_to_world<N>(m, n, f.vec3(8), f.varying(11));
+        }
       }
     }
     if (lighting.two_sided && !f.front_facing) n = n * F(-1.0f);
@@ -187,14 +199,17 @@ struct PhongShader {
                                      : simd::splat3<N>(lighting.light);
     LightTerms<N> light = blinn_phong<N>(n, l, view, maps.shininess);
     simd::Vec4<N> base{F(albedo.r), F(albedo.g), F(albedo.b), F(1.0f)};
-    if (maps.diffuse) base = sample_with_derivatives(*maps.diffuse, sampler, f, 6);
     simd::Vec3<N> ks = simd::splat3<N>(maps.specular_color);
-    if (maps.specular) {
-      simd::Vec4<N> k = sample_with_derivatives(*maps.specular, sampler, f, 6);
-      ks = ks * simd::Vec3<N>{k.x, k.y, k.z};
+    F a = F(alpha * maps.opacity);
+    if constexpr (kUv) {
+      if (maps.diffuse) base = sample_with_derivatives(*maps.diffuse, sampler, f, 6);
+      if (maps.specular) {
+        simd::Vec4<N> k = sample_with_derivatives(*maps.specular, sampler, f, 6);
+        ks = ks * simd::Vec3<N>{k.x, k.y, k.z};
+      }
+      a = base.w * a;
+      if (maps.alpha) a = a * sample_with_derivatives(*maps.alpha, sampler, f, 6).x;
     }
-    F a = base.w * F(alpha * maps.opacity);
-    if (maps.alpha) a = a * sample_with_derivatives(*maps.alpha, sampler, f, 6).x;
     F visible =
         lighting.shadow ? shadow_visibility<N>(*lighting.shadow, p, simd::dot(n, l)) : F(1.0f);
     F lit = F(lighting.ambient) + F(lighting.diffuse) * light.diffuse * visible;

@@ -127,16 +127,22 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
       SurfaceMaps maps = surf.maps;
       bool tangents = maps.normal && !maps.object_space;
       if (tangents && mesh.tangents.size() == mesh.positions.size()) {
-        return draw(
-            fb, state,
-            PhongShader<true>{in, surf.albedo, maps, sampler, lighting, camera.eye, opt.alpha},
-            indices, n);
+        return draw(fb, state,
+                    PhongShader<PhongInputs::kTangentFrame>{in, surf.albedo, maps, sampler,
+                                                            lighting, camera.eye, opt.alpha},
+                    indices, n);
       }
       if (tangents) maps.normal = nullptr;  // no tangent frame: the interpolated normal
-      return draw(
-          fb, state,
-          PhongShader<false>{in, surf.albedo, maps, sampler, lighting, camera.eye, opt.alpha},
-          indices, n);
+      if (maps.diffuse || maps.specular || maps.normal || maps.alpha) {
+        return draw(fb, state,
+                    PhongShader<PhongInputs::kUv>{in, surf.albedo, maps, sampler, lighting,
+                                                  camera.eye, opt.alpha},
+                    indices, n);
+      }
+      return draw(fb, state,
+                  PhongShader<PhongInputs::kPlain>{in, surf.albedo, maps, sampler, lighting,
+                                                   camera.eye, opt.alpha},
+                  indices, n);
     }
     case ShaderKind::kNormals:
       return draw(fb, state, NormalsShader{in}, indices, n);
