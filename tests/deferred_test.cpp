@@ -337,11 +337,36 @@ Scene small_triangle_scene(bool with_large, unsigned seed) {
   return scene;
 }
 
+// The same without derivatives, declared so: deferred tiles then shade the pixels that several
+// triangles won in a 4x4 block in one call, each with its own triangle's values.
+struct MixedProbeShader : ColorShader {
+  bool reads_derivatives() const { return false; }
+  template <int N>
+  SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
+    using F = simd::Float<N>;
+    F r = f.varying(0) + f.x * F(1.0f / 4096.0f);
+    F g = f.varying(1) + f.y * F(1.0f / 4096.0f);
+    F b = f.varying(2) * F(0.5f) + f.depth * F(0.5f);
+    F a = f.varying(3) * F(f.front_facing ? 1.0f : 0.5f);
+    f.color = {r, g, b, a};
+  }
+};
+
+// Declares no derivatives and reads them all the same.
+struct LyingProbeShader : ColorShader {
+  bool reads_derivatives() const { return false; }
+  template <int N>
+  SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
+    f.color = {f.ddx(f.varying(0)), f.varying(1), f.varying(2), f.varying(3)};
+  }
+};
+
+template <class Shader = WideProbeShader>
 Buffers render_wide(const Scene& scene, RenderState state, int threads, bool reference) {
   Framebuffer fb(301, 187);
   state.threads = threads;
   state.reference_path = reference;
-  WideProbeShader shader;
+  Shader shader;
   shader.positions = scene.positions.data();
   shader.colors = scene.colors.data();
   draw(fb, state, shader, scene.indices, uint32_t(scene.positions.size()));
@@ -368,6 +393,39 @@ TEST(Deferred, WideShaderWithDerivativesEqualsReference) {
       set_simd_level(cap);
     }
   }
+}
+
+// Small triangles of both facings under large ones (deferred tiles, blocks that several small
+// triangles won) with a shader that reads no derivatives: bit for bit the reference path's image,
+// at every level and on 1 and 2 threads.
+TEST(Deferred, WideShaderWithoutDerivativesShadesMixedBlocksAsReference) {
+  for (bool with_large : {false, true}) {
+    Scene scene = small_triangle_scene(with_large, 9);
+    for (DepthFunc func : {DepthFunc::kLess, DepthFunc::kLessEqual}) {
+      RenderState state = opaque_state(func);
+      Buffers reference = render_wide<MixedProbeShader>(scene, state, 1, true);
+      SimdLevel cap = simd_level();
+      for (int level = 0; level <= int(cap); ++level) {
+        set_simd_level(SimdLevel(level));
+        for (int threads : {1, 2}) {
+          EXPECT_TRUE(render_wide<MixedProbeShader>(scene, state, threads, false) == reference)
+              << (with_large ? "with large triangles" : "one layer") << ", threads " << threads
+              << ", " << simd_level_name(SimdLevel(level));
+        }
+      }
+      set_simd_level(cap);
+    }
+  }
+}
+
+// A shader that says it reads no derivatives and calls ddx stops with a message instead of
+// shading with differences across triangles.
+TEST(DeferredDeathTest, DerivativesInAMixedBlockStopWithAMessage) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  Scene scene = small_triangle_scene(true, 9);
+  RenderState state = opaque_state(DepthFunc::kLess);
+  EXPECT_DEATH(render_wide<LyingProbeShader>(scene, state, 1, false),
+               "read derivatives .* reads_derivatives\\(\\) returned false");
 }
 
 }  // namespace

@@ -19,7 +19,12 @@
 //   static constexpr bool kWritesDepth = true;  // the shader sets the depth: late depth test
 //   static constexpr bool kDiscards = true;     // a wide shader that calls f.discard()
 // A wide shader that neither writes depth nor discards lets opaque depth-tested draws resolve
-// visibility first and shade each visible pixel once (deferred shading in tiles).
+// visibility first and shade each visible pixel once (deferred shading in tiles). One that also
+// never reads derivatives (f.ddx, f.ddy, sampling with them) in a draw may say so:
+//   bool reads_derivatives() const { return false; }
+// and a 4x4 block whose pixels several triangles won is then shaded in one call, each pixel
+// with its own triangle's varyings (a 2x2 quad may mix triangles, so ddx and ddy would be
+// meaningless there: they stop the program with a message if called after all).
 // A scalar shader is taken to discard (it returns a bool) and is always shaded immediately.
 //
 // The vertex shader pulls its own inputs by index (from whatever arrays the shader holds), so
@@ -94,6 +99,9 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
   if constexpr (detail::WideShader<S>) {
     program.shade_block = detail::wide_shade_block<S>(simd_level());
     program.deferrable = !detail::WritesDepth<S> && !detail::DeclaresDiscards<S>;
+    if (program.deferrable && !detail::reads_derivatives(shader)) {
+      program.shade_mixed = detail::wide_shade_mixed<S>(simd_level());
+    }
   } else {
     program.shade_block = &detail::shade_block<S>;
   }

@@ -73,12 +73,37 @@ void shade_winners(const TileVisibility& vis, const Interpolants* const* interps
       uint32_t left = ~lanes_equal(ids, TileVisibility::kNoWinner) & 0xffffu;
       int x = vis.region.x0 + (b % kPerRow) * kBlockSize;
       int y = vis.region.y0 + (b / kPerRow) * kBlockSize;
-      // One call per distinct winner of the block, with exactly the pixels it won.
+      if (program.shade_mixed == nullptr) {
+        // One call per distinct winner of the block, with exactly the pixels it won.
+        while (left != 0) {
+          int32_t winner = ids[__builtin_ctz(left)];
+          uint32_t mask = lanes_equal(ids, winner);
+          left &= ~mask;
+          program.shade_block(program.shader, resolved_target, *interps[winner], x, y, mask);
+        }
+        continue;
+      }
+      // The shader reads no derivatives: one call for all the winners of each facing (the
+      // shader sees one facing per call).
+      MixedBlock facing[2];  // back, front
       while (left != 0) {
         int32_t winner = ids[__builtin_ctz(left)];
         uint32_t mask = lanes_equal(ids, winner);
         left &= ~mask;
-        program.shade_block(program.shader, resolved_target, *interps[winner], x, y, mask);
+        const Interpolants* in = interps[winner];
+        MixedBlock& group = facing[in->front_facing ? 1 : 0];
+        group.winner[group.count] = in;
+        group.mask[group.count++] = mask;
+      }
+      for (int side = 0; side < 2; ++side) {
+        MixedBlock& group = facing[side];
+        if (group.count == 1) {
+          program.shade_block(program.shader, resolved_target, *group.winner[0], x, y,
+                              group.mask[0]);
+        } else if (group.count > 1) {
+          group.front_facing = side == 1;
+          program.shade_mixed(program.shader, resolved_target, group, x, y);
+        }
       }
     }
   }

@@ -63,6 +63,7 @@ struct FlatShader {
   glm::vec4 color;
   bool srgb = false;  // encode the output (the linear workflow)
   glm::vec4 vertex(uint32_t i, float*) const { return in.clip(i); }
+  bool reads_derivatives() const { return false; }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     f.color = {color.r, color.g, color.b, color.a};
@@ -79,6 +80,7 @@ struct GouraudShader {
   glm::vec3 albedo;
   Lighting lighting;
   float alpha = 1.0f;
+  bool reads_derivatives() const { return false; }
   glm::vec3 lit(const glm::vec3& n) const {
     float d = std::max(glm::dot(n, lighting.light), 0.0f);
     return albedo * (lighting.ambient + lighting.diffuse * d);
@@ -108,6 +110,7 @@ struct TextureShader {
   Sampler sampler;
   float alpha = 1.0f;
   bool srgb = false;  // encode the output (the linear workflow)
+  bool reads_derivatives() const { return sampler.filter == Filter::kTrilinear; }
   glm::vec4 vertex(uint32_t i, float* v) const {
     v[0] = in.mesh->uvs[i].x, v[1] = in.mesh->uvs[i].y;
     return in.clip(i);
@@ -155,6 +158,8 @@ struct PhongShader {
   Lighting lighting;
   glm::vec3 eye;
   float alpha = 1.0f;
+  // Only the maps' trilinear lookups read derivatives (shadows and lighting do not).
+  bool reads_derivatives() const { return kUv && sampler.filter == Filter::kTrilinear; }
   glm::vec4 vertex(uint32_t i, float* v) const {
     const glm::vec3& p = in.mesh->positions[i];
     const glm::vec3& n = in.mesh->normals[i];
@@ -223,6 +228,7 @@ struct PhongShader {
 struct NormalsShader {
   static constexpr int kVaryings = 3;
   MeshInputs in;
+  bool reads_derivatives() const { return false; }
   glm::vec4 vertex(uint32_t i, float* v) const {
     const glm::vec3& n = in.mesh->normals[i];
     v[0] = n.x, v[1] = n.y, v[2] = n.z;

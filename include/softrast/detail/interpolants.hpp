@@ -67,6 +67,21 @@ struct ShadeTarget {
 using ShadeBlockFn = void (*)(const void* shader, const ShadeTarget& target,
                               const Interpolants& interp, int x, int y, uint32_t mask);
 
+// A resolved 4x4 block whose visible pixels were won by several triangles of one facing, shaded
+// in one call (ShadeMixedFn): winner k's interpolants and the pixels it won.
+struct MixedBlock {
+  const Interpolants* winner[16];
+  uint32_t mask[16];
+  int count = 0;
+  bool front_facing = true;
+};
+
+// Shades a MixedBlock at (x, y): each pixel interpolates its own triangle's planes, so it gets
+// the bits a ShadeBlockFn call for its triangle alone would give. Only for shaders that read no
+// derivatives: a 2x2 quad's pixels may belong to different triangles.
+using ShadeMixedFn = void (*)(const void* shader, const ShadeTarget& target,
+                              const MixedBlock& block, int x, int y);
+
 // `deferrable`: the shader neither discards nor writes depth, so with an opaque, depth-writing
 // less / less-equal state the image depends only on the nearest fragment of each pixel, and the
 // pipeline may resolve visibility first and shade each visible pixel once (ShadeTarget::resolved).
@@ -74,7 +89,8 @@ struct FragmentProgram {
   ShadeBlockFn shade_block = nullptr;
   const void* shader = nullptr;
   bool deferrable = false;
-  bool writes_depth = false;  // the shader sets the depth (late depth test)
+  bool writes_depth = false;           // the shader sets the depth (late depth test)
+  ShadeMixedFn shade_mixed = nullptr;  // deferrable shaders that read no derivatives in this draw
 };
 
 // The vertex stage's output: per vertex a clip-space position (x, y, z, w) followed by

@@ -11,6 +11,7 @@
 #pragma GCC diagnostic ignored "-Wpsabi"
 
 #include <algorithm>
+#include <concepts>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -25,6 +26,10 @@
 
 namespace softrast {
 
+namespace detail {
+[[noreturn]] void undeclared_derivatives();
+}  // namespace detail
+
 // What a wide fragment shader sees of one 4x4 block, and what it writes. Lane i is the pixel
 // (x0 + i % 4, y0 + i / 4). Every member function is always inlined: a wide shader is inlined
 // into each SIMD level's block function, and an out-of-line copy compiled for baseline x86-64
@@ -32,10 +37,13 @@ namespace softrast {
 template <int N>
 struct Fragments {
   using F = simd::Float<N>;
-  F x, y;                       // window coordinates of the samples (pixel centres)
-  F depth;                      // window depth in [0, 1]; a shader with kWritesDepth may set it
-  simd::Int<N> live;            // lanes still to be written: covered and not discarded
-  bool front_facing = true;     // the primitive's facing
+  F x, y;                    // window coordinates of the samples (pixel centres)
+  F depth;                   // window depth in [0, 1]; a shader with kWritesDepth may set it
+  simd::Int<N> live;         // lanes still to be written: covered and not discarded
+  bool front_facing = true;  // the primitive's facing
+  // The pixels belong to several triangles (a shader whose reads_derivatives() is false): no
+  // derivatives then; ddx and ddy stop the program.
+  bool several_triangles = false;
   const F* varyings = nullptr;  // the shader's kVaryings values, perspective-correct
   simd::Vec4<N> color;          // the output, set by the shader
 
@@ -49,8 +57,14 @@ struct Fragments {
   }
   // Change of a value to the next pixel right (ddx) or down (ddy), the same for the four pixels of
   // each 2x2 quad (coarse derivatives, as D3D's ddx_coarse).
-  SOFTRAST_SIMD_INLINE F ddx(const F& v) const { return quad_difference(v, 1); }
-  SOFTRAST_SIMD_INLINE F ddy(const F& v) const { return quad_difference(v, 4); }
+  SOFTRAST_SIMD_INLINE F ddx(const F& v) const {
+    if (several_triangles) detail::undeclared_derivatives();
+    return quad_difference(v, 1);
+  }
+  SOFTRAST_SIMD_INLINE F ddy(const F& v) const {
+    if (several_triangles) detail::undeclared_derivatives();
+    return quad_difference(v, 4);
+  }
   // Drops lanes (mask lanes -1) from the output; only for shaders declaring kDiscards = true.
   SOFTRAST_SIMD_INLINE void discard(const simd::Int<N>& lanes) { live = live & ~lanes; }
 
@@ -179,6 +193,26 @@ SOFTRAST_SIMD_INLINE simd::Int<N> blend(BlendMode mode, const simd::Vec4<N>& col
   std::abort();
 }
 
+[[noreturn]] inline void undeclared_derivatives() {
+  std::fprintf(stderr,
+               "softrast: a shader read derivatives (ddx, ddy) although its reads_derivatives() "
+               "returned false\n");
+  std::abort();
+}
+
+// Whether shader `s` reads derivatives in this draw: its reads_derivatives(), if it has one;
+// otherwise it is taken to.
+template <class S>
+bool reads_derivatives(const S& s) {
+  if constexpr (requires {
+                  { s.reads_derivatives() } -> std::convertible_to<bool>;
+                }) {
+    return s.reads_derivatives();
+  } else {
+    return true;
+  }
+}
+
 // Shades the covered pixels (`mask`) of the 4x4 block at (x, y) with shader S on N-lane vectors.
 // kCommon compiles the state most draws use (depth less with writes, opaque) with its branches
 // resolved; `target.resolved` means visibility is already decided (see ShadeTarget).
@@ -256,6 +290,68 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   simd::select(f.live, packed, old).store(color_at);
 }
 
+// Shades a resolved block won by several triangles of one facing (MixedBlock) with shader S on
+// N-lane vectors. Each lane takes its own triangle's plane coefficients, selected per winner, and
+// then runs shade_block_wide's operations in the same order: every pixel gets the bits its
+// triangle's own call would give it. The depth is the resolved one, already in the framebuffer
+// (the value that call would compute).
+template <class S, int N>
+SOFTRAST_SIMD_INLINE void shade_mixed_wide(const S& shader, const ShadeTarget& target,
+                                           const MixedBlock& block, int x, int y) {
+  using F = simd::Float<N>;
+  using I = simd::Int<N>;
+  constexpr int kN = S::kVaryings > 0 ? S::kVaryings : 1;
+  Framebuffer& fb = *target.framebuffer;
+
+  F x_ref(0.0f), y_ref(0.0f);
+  F a0(0.0f), dadx(0.0f), dady(0.0f);  // 1/w
+  F v0[kN], vx[kN], vy[kN];            // varying / w
+  for (int i = 0; i < S::kVaryings; ++i) v0[i] = vx[i] = vy[i] = F(0.0f);
+  uint32_t all = 0;
+  for (int k = 0; k < block.count; ++k) {
+    const Interpolants& in = *block.winner[k];
+    const I m = simd::lanes_of<N>(block.mask[k]);
+    all |= block.mask[k];
+    x_ref = simd::select(m, F(in.x_ref), x_ref);
+    y_ref = simd::select(m, F(in.y_ref), y_ref);
+    a0 = simd::select(m, F(in.inv_w.a0), a0);
+    dadx = simd::select(m, F(in.inv_w.dadx), dadx);
+    dady = simd::select(m, F(in.inv_w.dady), dady);
+    for (int i = 0; i < S::kVaryings; ++i) {
+      v0[i] = simd::select(m, F(in.var[i].a0), v0[i]);
+      vx[i] = simd::select(m, F(in.var[i].dadx), vx[i]);
+      vy[i] = simd::select(m, F(in.var[i].dady), vy[i]);
+    }
+  }
+
+  Fragments<N> f;
+  f.x = simd::to_float(I(x) + simd::lane_column<N>()) + F(0.5f);
+  f.y = simd::to_float(I(y) + simd::lane_row<N>()) + F(0.5f);
+  F dx = f.x - x_ref, dy = f.y - y_ref;
+  f.live = simd::lanes_of<N>(all);
+  f.depth = F::load(fb.depth_block(x, y));
+  // eval_plane's operations, with per-lane coefficients.
+  F inv_w = a0 + dadx * dx + dady * dy;
+  inv_w = simd::select((inv_w < F(1.0e-30f)) & (inv_w > F(-1.0e-30f)), F(1.0e-30f), inv_w);
+  F w = F(1.0f) / inv_w;
+  F var[kN];
+  for (int i = 0; i < S::kVaryings; ++i) var[i] = (v0[i] + vx[i] * dx + vy[i] * dy) * w;
+  f.varyings = var;
+  f.front_facing = block.front_facing;
+  f.several_triangles = true;
+  f.color = {F(0.0f), F(0.0f), F(0.0f), F(1.0f)};
+  shader.template shade<N>(f);
+  const uint32_t live = simd::bits(f.live);
+  if (live != all) undeclared_discard();
+  int32_t* color_at = reinterpret_cast<int32_t*>(fb.color_block(x, y));
+  I packed = pack_rgba8<N>(f.color);
+  if (live == 0xffffu) {
+    packed.store(color_at);
+    return;
+  }
+  simd::select(f.live, packed, I::load(color_at)).store(color_at);
+}
+
 template <class S, int N>
 SOFTRAST_SIMD_INLINE void shade_block_level(const void* shader, const ShadeTarget& target,
                                             const Interpolants& interp, int x, int y,
@@ -304,6 +400,30 @@ template <class S>
   shade_block_level<S, 16>(shader, target, interp, x, y, mask);
 }
 
+template <class S>
+[[gnu::flatten]] void shade_mixed_sse2(const void* shader, const ShadeTarget& target,
+                                       const MixedBlock& block, int x, int y) {
+  shade_mixed_wide<S, 4>(*static_cast<const S*>(shader), target, block, x, y);
+}
+template <class S>
+[[gnu::target("sse4.2"), gnu::flatten]] void shade_mixed_sse4(const void* shader,
+                                                              const ShadeTarget& target,
+                                                              const MixedBlock& block, int x,
+                                                              int y) {
+  shade_mixed_wide<S, 4>(*static_cast<const S*>(shader), target, block, x, y);
+}
+template <class S>
+[[gnu::target("avx2"), gnu::flatten]] void shade_mixed_avx2(const void* shader,
+                                                            const ShadeTarget& target,
+                                                            const MixedBlock& block, int x, int y) {
+  shade_mixed_wide<S, 8>(*static_cast<const S*>(shader), target, block, x, y);
+}
+template <class S>
+[[gnu::target("avx512f,avx512bw,avx512dq,avx512vl"), gnu::flatten]] void shade_mixed_avx512(
+    const void* shader, const ShadeTarget& target, const MixedBlock& block, int x, int y) {
+  shade_mixed_wide<S, 16>(*static_cast<const S*>(shader), target, block, x, y);
+}
+
 // SOFTRAST_SHADERS_BASELINE_ONLY (the fuzz and sanitizer builds define it) compiles each shader
 // for the baseline alone, in its general variant only: the sanitizers' instrumentation of every
 // shader at four levels made the two files that hold the built-in shaders take most of an hour
@@ -325,6 +445,25 @@ ShadeBlockFn wide_shade_block([[maybe_unused]] SimdLevel level) {
       break;
   }
   return &shade_block_sse2<S>;
+#endif
+}
+
+template <class S>
+ShadeMixedFn wide_shade_mixed([[maybe_unused]] SimdLevel level) {
+#if defined(SOFTRAST_SHADERS_BASELINE_ONLY)
+  return &shade_mixed_sse2<S>;
+#else
+  switch (level) {
+    case SimdLevel::kAvx512:
+      return &shade_mixed_avx512<S>;
+    case SimdLevel::kAvx2:
+      return &shade_mixed_avx2<S>;
+    case SimdLevel::kSse4:
+      return &shade_mixed_sse4<S>;
+    case SimdLevel::kSse2:
+      break;
+  }
+  return &shade_mixed_sse2<S>;
 #endif
 }
 
