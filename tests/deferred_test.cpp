@@ -418,6 +418,51 @@ TEST(Deferred, WideShaderWithoutDerivativesShadesMixedBlocksAsReference) {
   }
 }
 
+// Small triangles (2 to 8 pixels across, a few larger) scattered sparsely enough that every tile
+// is shaded immediately, overlapping one another often, of both facings; a third at one shared
+// depth (exact ties: LEQUAL lets the later one win). In submission order the held blocks of
+// BlockBatch must still show every pixel its fragments in order.
+Scene scattered_small_triangles(int count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  Scene scene;
+  for (int t = 0; t < count; ++t) {
+    glm::vec4 color(unit(rng), unit(rng), unit(rng), 1.0f);
+    float cx = -1.0f + 2.0f * unit(rng), cy = -1.0f + 2.0f * unit(rng);
+    if (t % 3 == 0) cx = -1.0f + 0.5f * (cx + 1.0f) * 0.3f;  // ties crowd the left 30 %
+    // In NDC: 2 to 8 pixels at 301 x 187; every tenth 10 to 20 (shaded at once, not held).
+    float size = (t % 10 == 5 ? 10.0f + 10.0f * unit(rng) : 2.0f + 6.0f * unit(rng)) / 187.0f;
+    float shared = t % 3 == 0 ? 0.25f : -0.9f + 1.8f * unit(rng);
+    glm::vec4 v[3];
+    for (glm::vec4& p : v) {
+      // w = 1 at the shared depth: every pixel of those triangles gets exactly that depth.
+      float w = t % 3 == 0 ? 1.0f : 0.8f + 0.4f * unit(rng);
+      float z = t % 3 == 0 ? shared : shared + 0.1f * unit(rng);
+      p = glm::vec4((cx + size * (unit(rng) - 0.5f)) * w, (cy + size * (unit(rng) - 0.5f)) * w,
+                    z * w, w);
+    }
+    scene.triangle(v[0], v[1], v[2], color);  // random winding: both facings
+  }
+  return scene;
+}
+
+TEST(Deferred, BatchedSmallTrianglesInImmediateTilesEqualReference) {
+  Scene scene = scattered_small_triangles(3000, 5);
+  for (DepthFunc func : {DepthFunc::kLess, DepthFunc::kLessEqual}) {
+    RenderState state = opaque_state(func);
+    Buffers reference = render_wide<MixedProbeShader>(scene, state, 1, true);
+    SimdLevel cap = simd_level();
+    for (int level = 0; level <= int(cap); ++level) {
+      set_simd_level(SimdLevel(level));
+      for (int threads : {1, 2}) {
+        EXPECT_TRUE(render_wide<MixedProbeShader>(scene, state, threads, false) == reference)
+            << "threads " << threads << ", " << simd_level_name(SimdLevel(level));
+      }
+    }
+    set_simd_level(cap);
+  }
+}
+
 // A shader that says it reads no derivatives and calls ddx stops with a message instead of
 // shading with differences across triangles.
 TEST(DeferredDeathTest, DerivativesInAMixedBlockStopWithAMessage) {

@@ -442,6 +442,27 @@ inline void gather(const int32_t* base, const Native<4>::I& index, Native<4>::I&
                                                 __m512i(index), base, 4));
 }
 
+// r[i] = table[index[i]] for a table of 16 floats, indices in [0, 16): a permute, no memory
+// access per lane where the instruction set has one.
+inline void lookup16(const float* table, const Native<4>::I& index, Native<4>::F& r) {
+  for (int i = 0; i < 4; ++i) r[i] = table[index[i]];
+}
+[[gnu::target("avx2")]] inline void lookup16(const float* table, const Native<8>::I& index,
+                                             Native<8>::F& r) {
+  __m256i i = __m256i(index);
+  __m256 lo = _mm256_permutevar8x32_ps(_mm256_loadu_ps(table), i);  // index & 7
+  __m256 hi = _mm256_permutevar8x32_ps(_mm256_loadu_ps(table + 8), i);
+  __m256 upper = _mm256_castsi256_ps(_mm256_slli_epi32(i, 28));  // index & 8 in the sign bit
+  r = Native<8>::F(_mm256_blendv_ps(lo, hi, upper));
+}
+[[gnu::target("avx512f")]] inline void lookup16(const float* table, const Native<16>::I& index,
+                                                Native<16>::F& r) {
+  // The zero-masked form: GCC 12's unmasked one starts from _mm512_undefined_ps, which its
+  // -Wmaybe-uninitialized reports (bug 105593).
+  r = Native<16>::F(
+      _mm512_maskz_permutexvar_ps(__mmask16(0xffff), __m512i(index), _mm512_loadu_ps(table)));
+}
+
 // lo[i] = base[index[i]] and hi[i] = base[index[i] + 1]: two neighbouring 32-bit elements per
 // lane with one 64-bit load (half the loads of two gathers).
 inline void gather_pair(const int32_t* base, const Native<4>::I& index, Native<4>::I& lo,
@@ -534,6 +555,14 @@ template <int N>
 SOFTRAST_SIMD_INLINE Int<N> gather(const int32_t* base, const Int<N>& index) {
   Int<N> r;
   for (int k = 0; k < Int<N>::kParts; ++k) isa::gather(base, index.p[k], r.p[k]);
+  return r;
+}
+
+// Lane i: table[index[i]], for a table of 16 floats and every index in [0, 16).
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> lookup16(const float* table, const Int<N>& index) {
+  Float<N> r;
+  for (int k = 0; k < Float<N>::kParts; ++k) isa::lookup16(table, index.p[k], r.p[k]);
   return r;
 }
 

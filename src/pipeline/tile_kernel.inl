@@ -246,15 +246,30 @@ struct BlockTarget {
   const TriRecord& rec;
   DepthTerms depth;
 
+  // Immediate with a batch: whether the triangle is small enough (its area inside the tile at
+  // most kBatchedExtent pixels each way) for its blocks to be held for the batch.
+  static constexpr int kBatchedExtent = 8;
+  bool batched = false;
+
   BlockTarget(TileJob& j, const TriRecord& r, int32_t id, const PixelRect& area) : job(j), rec(r) {
-    if constexpr (kMode != Mode::kImmediate) {
+    if constexpr (kMode == Mode::kImmediate) {
+      batched = area.x1 - area.x0 <= kBatchedExtent && area.y1 - area.y0 <= kBatchedExtent;
+    } else {
       depth_terms(r.interp(), id, area.x0 & ~(kBlockSize - 1), area.x1, area.y0 & ~(kBlockSize - 1),
                   area.y1, depth);
     }
   }
   [[gnu::always_inline]] void operator()(int x, int y, uint32_t bits) {
     if constexpr (kMode == Mode::kImmediate) {
-      job.program->shade_block(job.program->shader, *job.target, rec.interp(), x, y, bits);
+      if (job.batch != nullptr) {
+        if (batched) {
+          job.batch->add(rec.interp(), x, y, bits);
+        } else {
+          job.batch->shade_now(rec.interp(), x, y, bits);
+        }
+      } else {
+        job.program->shade_block(job.program->shader, *job.target, rec.interp(), x, y, bits);
+      }
     } else {
       TileVisibility& v = *job.visibility;
       int b = v.block_index(x, y);

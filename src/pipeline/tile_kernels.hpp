@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "pipeline/block_batch.hpp"
 #include "pipeline/tile_visibility.hpp"
 #include "pipeline/triangle_record.hpp"
 #include "softrast/simd_level.hpp"
@@ -19,9 +20,10 @@ namespace softrast::detail {
 
 struct TileJob {
   PixelRect region;  // the tile's pixels inside the image
-  // Immediate: blocks go to program.shade_block with `target`.
+  // Immediate: blocks go to program.shade_block with `target`, or through `batch` when set.
   const FragmentProgram* program = nullptr;
   const ShadeTarget* target = nullptr;
+  BlockBatch* batch = nullptr;
   // Deferred: blocks go to the depth resolve; record k of the tile gets id next_id + k and its
   // interpolants in interps[id] (sized by the caller).
   TileVisibility* visibility = nullptr;

@@ -67,8 +67,9 @@ struct ShadeTarget {
 using ShadeBlockFn = void (*)(const void* shader, const ShadeTarget& target,
                               const Interpolants& interp, int x, int y, uint32_t mask);
 
-// A resolved 4x4 block whose visible pixels were won by several triangles of one facing, shaded
-// in one call (ShadeMixedFn): winner k's interpolants and the pixels it won.
+// A 4x4 block whose pixels several triangles of one facing cover, shaded in one call
+// (ShadeMixedFn): triangle k's interpolants and its pixels, disjoint from the others'. Resolved
+// (deferred tiles): the pixels each triangle won; immediate (BlockBatch): the pixels each covers.
 struct MixedBlock {
   const Interpolants* winner[16];
   uint32_t mask[16];

@@ -290,11 +290,13 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   simd::select(f.live, packed, old).store(color_at);
 }
 
-// Shades a resolved block won by several triangles of one facing (MixedBlock) with shader S on
-// N-lane vectors. Each lane takes its own triangle's plane coefficients, selected per winner, and
-// then runs shade_block_wide's operations in the same order: every pixel gets the bits its
-// triangle's own call would give it. The depth is the resolved one, already in the framebuffer
-// (the value that call would compute).
+// Shades a block whose pixels several triangles of one facing cover (MixedBlock) with shader S
+// on N-lane vectors. Each lane takes its own triangle's plane coefficients, selected per winner,
+// and then runs shade_block_wide's operations in the same order: every pixel gets the bits its
+// triangle's own call would give it. Resolved (deferred tiles): the pixels are the ones each
+// triangle won, and their depth is already in the framebuffer (the value that call would
+// compute). Otherwise (immediate tiles, BlockBatch): the triangles cover disjoint pixels, and
+// each lane is depth-tested and written as that call would do it.
 template <class S, int N>
 SOFTRAST_SIMD_INLINE void shade_mixed_wide(const S& shader, const ShadeTarget& target,
                                            const MixedBlock& block, int x, int y) {
@@ -303,46 +305,89 @@ SOFTRAST_SIMD_INLINE void shade_mixed_wide(const S& shader, const ShadeTarget& t
   constexpr int kN = S::kVaryings > 0 ? S::kVaryings : 1;
   Framebuffer& fb = *target.framebuffer;
 
-  F x_ref(0.0f), y_ref(0.0f);
-  F a0(0.0f), dadx(0.0f), dady(0.0f);  // 1/w
-  F v0[kN], vx[kN], vy[kN];            // varying / w
-  for (int i = 0; i < S::kVaryings; ++i) v0[i] = vx[i] = vy[i] = F(0.0f);
+  // The triangles' coefficients as tables (entry k: triangle k), and each lane's triangle; a
+  // coefficient of all lanes is then one permute, however many triangles share the block. Lanes
+  // no triangle covers take triangle 0's (finite, never written); entries past block.count are
+  // never looked up.
+  enum { kXRef, kYRef, kInvW, kVar = kInvW + 3, kRows = kVar + 3 * kN };
+  alignas(64) float table[kRows][16];
+  I lane_winner(0);
   uint32_t all = 0;
   for (int k = 0; k < block.count; ++k) {
     const Interpolants& in = *block.winner[k];
-    const I m = simd::lanes_of<N>(block.mask[k]);
-    all |= block.mask[k];
-    x_ref = simd::select(m, F(in.x_ref), x_ref);
-    y_ref = simd::select(m, F(in.y_ref), y_ref);
-    a0 = simd::select(m, F(in.inv_w.a0), a0);
-    dadx = simd::select(m, F(in.inv_w.dadx), dadx);
-    dady = simd::select(m, F(in.inv_w.dady), dady);
+    table[kXRef][k] = in.x_ref;
+    table[kYRef][k] = in.y_ref;
+    table[kInvW][k] = in.inv_w.a0;
+    table[kInvW + 1][k] = in.inv_w.dadx;
+    table[kInvW + 2][k] = in.inv_w.dady;
     for (int i = 0; i < S::kVaryings; ++i) {
-      v0[i] = simd::select(m, F(in.var[i].a0), v0[i]);
-      vx[i] = simd::select(m, F(in.var[i].dadx), vx[i]);
-      vy[i] = simd::select(m, F(in.var[i].dady), vy[i]);
+      table[kVar + 3 * i][k] = in.var[i].a0;
+      table[kVar + 3 * i + 1][k] = in.var[i].dadx;
+      table[kVar + 3 * i + 2][k] = in.var[i].dady;
     }
+    lane_winner = simd::select(simd::lanes_of<N>(block.mask[k]), I(k), lane_winner);
+    all |= block.mask[k];
   }
+  auto per_lane = [&](int row) { return simd::lookup16<N>(table[row], lane_winner); };
+  const F x_ref = per_lane(kXRef), y_ref = per_lane(kYRef);
+  const F a0 = per_lane(kInvW), dadx = per_lane(kInvW + 1), dady = per_lane(kInvW + 2);
 
   Fragments<N> f;
   f.x = simd::to_float(I(x) + simd::lane_column<N>()) + F(0.5f);
   f.y = simd::to_float(I(y) + simd::lane_row<N>()) + F(0.5f);
   F dx = f.x - x_ref, dy = f.y - y_ref;
   f.live = simd::lanes_of<N>(all);
-  f.depth = F::load(fb.depth_block(x, y));
+  float* depth_at = fb.depth_block(x, y);
+  const F stored = F::load(depth_at);
+  F z = stored;
+  if (!target.resolved) {
+    // Immediate (the state deferred shading needs: opaque, depth test less or less-equal with
+    // writes): each lane's depth from its own triangle's plane, as shade_block_wide computes it,
+    // and the early test.
+    // dx and dy are each lane's own triangle's (its x_ref and y_ref), so they are converted to
+    // double once, and each triangle's plane is evaluated on them with eval_plane's operations.
+    using D = typename simd::Native<N>::D;
+    D ddx[F::kParts], ddy[F::kParts];
+    for (int p = 0; p < F::kParts; ++p) {
+      ddx[p] = __builtin_convertvector(dx.p[p], D);
+      ddy[p] = __builtin_convertvector(dy.p[p], D);
+    }
+    for (int k = 0; k < block.count; ++k) {
+      const DepthPlane& plane = block.winner[k]->z;
+      D a0 = D{} + plane.a0, da_dx = D{} + plane.dadx, da_dy = D{} + plane.dady;
+      F own;
+      for (int p = 0; p < F::kParts; ++p) {
+        own.p[p] = __builtin_convertvector((a0 + da_dx * ddx[p]) + da_dy * ddy[p],
+                                           typename simd::Native<N>::F);
+      }
+      z = simd::select(simd::lanes_of<N>(block.mask[k]), simd::clamp(own, F(0.0f), F(1.0f)), z);
+    }
+    // LESS or LEQUAL (the only tests a batch is made for), without a switch.
+    I passes = z < stored;
+    if (target.state->depth_func == DepthFunc::kLessEqual) passes = passes | (z == stored);
+    f.live = f.live & passes;
+    if (!simd::any(f.live)) return;
+  }
+  f.depth = z;
   // eval_plane's operations, with per-lane coefficients.
   F inv_w = a0 + dadx * dx + dady * dy;
   inv_w = simd::select((inv_w < F(1.0e-30f)) & (inv_w > F(-1.0e-30f)), F(1.0e-30f), inv_w);
   F w = F(1.0f) / inv_w;
   F var[kN];
-  for (int i = 0; i < S::kVaryings; ++i) var[i] = (v0[i] + vx[i] * dx + vy[i] * dy) * w;
+  for (int i = 0; i < S::kVaryings; ++i) {
+    var[i] = (per_lane(kVar + 3 * i) + per_lane(kVar + 3 * i + 1) * dx +
+              per_lane(kVar + 3 * i + 2) * dy) *
+             w;
+  }
   f.varyings = var;
   f.front_facing = block.front_facing;
   f.several_triangles = true;
   f.color = {F(0.0f), F(0.0f), F(0.0f), F(1.0f)};
+  const uint32_t shaded = simd::bits(f.live);
   shader.template shade<N>(f);
   const uint32_t live = simd::bits(f.live);
-  if (live != all) undeclared_discard();
+  if (live != shaded) undeclared_discard();
+  if (!target.resolved) simd::select(f.live, z, stored).store(depth_at);
   int32_t* color_at = reinterpret_cast<int32_t*>(fb.color_block(x, y));
   I packed = pack_rgba8<N>(f.color);
   if (live == 0xffffu) {
