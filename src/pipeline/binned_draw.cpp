@@ -276,6 +276,7 @@ class BinnedDraw {
         rasterize_triangle_scanline(rec.coverage, job.region, shading.sink(rec.interp()));
       }
     }
+    if (batch) batch->flush();  // the tile's last held blocks
   }
 
   // Phase 2, deferred shading (tile_visibility.hpp): visibility of all the tile's triangles

@@ -21,7 +21,7 @@ class BlockBatch {
  public:
   BlockBatch(const FragmentProgram& program, const ShadeTarget& target)
       : program_(program), target_(target) {}
-  ~BlockBatch() { flush(); }
+  ~BlockBatch() { flush(); }  // in case the owner did not: held pixels are never dropped
   BlockBatch(const BlockBatch&) = delete;
   BlockBatch& operator=(const BlockBatch&) = delete;
 
