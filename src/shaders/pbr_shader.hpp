@@ -96,6 +96,16 @@ struct PbrShader {
   float alpha = 1.0f;  // RenderOptions::alpha, times the material's in BLEND mode
   bool blend = false;
 
+  // Only trilinear lookups read derivatives: the five maps are the only textures sampled.
+  bool reads_derivatives() const {
+    const PbrMaterial& m = *material;
+    for (const TextureSlot* slot : {&m.base_color_map, &m.metallic_roughness_map, &m.normal_map,
+                                    &m.occlusion_map, &m.emissive_map}) {
+      if (*slot && slot->sampler.filter == Filter::kTrilinear) return true;
+    }
+    return false;
+  }
+
   glm::vec4 vertex(uint32_t i, float* v) const {
     const Mesh& m = *in.mesh;
     const glm::vec3& n = m.normals[i];
