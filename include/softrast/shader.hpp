@@ -24,7 +24,10 @@
 //   bool reads_derivatives() const { return false; }
 // and a 4x4 block whose pixels several triangles won is then shaded in one call, each pixel
 // with its own triangle's varyings (a 2x2 quad may mix triangles, so ddx and ddy would be
-// meaningless there: they stop the program with a message if called after all).
+// meaningless there: they stop the program with a message if called after all). A shader whose
+// fragment work is only a few operations (the built-in Gouraud copies its varyings) gains nothing
+// from that, since picking each pixel's triangle costs about as much; it may say so with
+//   static constexpr bool kCheapToShade = true;
 // A scalar shader is taken to discard (it returns a bool) and is always shaded immediately.
 //
 // The vertex shader pulls its own inputs by index (from whatever arrays the shader holds), so
@@ -99,7 +102,7 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
   if constexpr (detail::WideShader<S>) {
     program.shade_block = detail::wide_shade_block<S>(simd_level());
     program.deferrable = !detail::WritesDepth<S> && !detail::DeclaresDiscards<S>;
-    if (program.deferrable && !detail::reads_derivatives(shader)) {
+    if (program.deferrable && !detail::reads_derivatives(shader) && !detail::CheapToShade<S>) {
       program.shade_mixed = detail::wide_shade_mixed<S>(simd_level());
     }
   } else {

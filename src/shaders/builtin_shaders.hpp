@@ -59,11 +59,11 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_with_derivatives(const Texture& t, con
 
 struct FlatShader {
   static constexpr int kVaryings = 0;
+  static constexpr bool kCheapToShade = true;  // a constant colour (see GouraudShader)
   MeshInputs in;
   glm::vec4 color;
   bool srgb = false;  // encode the output (the linear workflow)
   glm::vec4 vertex(uint32_t i, float*) const { return in.clip(i); }
-  bool reads_derivatives() const { return false; }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     f.color = {color.r, color.g, color.b, color.a};
@@ -76,11 +76,13 @@ struct FlatShader {
 template <bool kTwoSided>
 struct GouraudShader {
   static constexpr int kVaryings = kTwoSided ? 6 : 3;
+  // Its fragment stage copies three varyings: shading several small triangles per call (lanes
+  // picking their triangle's planes) measured as slow or slower (spheres_1m, AVX2 61 -> 65 ms).
+  static constexpr bool kCheapToShade = true;
   MeshInputs in;
   glm::vec3 albedo;
   Lighting lighting;
   float alpha = 1.0f;
-  bool reads_derivatives() const { return false; }
   glm::vec3 lit(const glm::vec3& n) const {
     float d = std::max(glm::dot(n, lighting.light), 0.0f);
     return albedo * (lighting.ambient + lighting.diffuse * d);

@@ -200,6 +200,11 @@ SOFTRAST_SIMD_INLINE simd::Int<N> blend(BlendMode mode, const simd::Vec4<N>& col
   std::abort();
 }
 
+template <class S>
+concept CheapToShade = requires {
+  requires S::kCheapToShade;
+};
+
 // Whether shader `s` reads derivatives in this draw: its reads_derivatives(), if it has one;
 // otherwise it is taken to.
 template <class S>
@@ -344,22 +349,9 @@ SOFTRAST_SIMD_INLINE void shade_mixed_wide(const S& shader, const ShadeTarget& t
     // Immediate (the state deferred shading needs: opaque, depth test less or less-equal with
     // writes): each lane's depth from its own triangle's plane, as shade_block_wide computes it,
     // and the early test.
-    // dx and dy are each lane's own triangle's (its x_ref and y_ref), so they are converted to
-    // double once, and each triangle's plane is evaluated on them with eval_plane's operations.
-    using D = typename simd::Native<N>::D;
-    D ddx[F::kParts], ddy[F::kParts];
-    for (int p = 0; p < F::kParts; ++p) {
-      ddx[p] = __builtin_convertvector(dx.p[p], D);
-      ddy[p] = __builtin_convertvector(dy.p[p], D);
-    }
     for (int k = 0; k < block.count; ++k) {
-      const DepthPlane& plane = block.winner[k]->z;
-      D a0 = D{} + plane.a0, da_dx = D{} + plane.dadx, da_dy = D{} + plane.dady;
-      F own;
-      for (int p = 0; p < F::kParts; ++p) {
-        own.p[p] = __builtin_convertvector((a0 + da_dx * ddx[p]) + da_dy * ddy[p],
-                                           typename simd::Native<N>::F);
-      }
+      const Interpolants& in = *block.winner[k];
+      F own = eval_plane<N>(in.z, f.x - F(in.x_ref), f.y - F(in.y_ref));
       z = simd::select(simd::lanes_of<N>(block.mask[k]), simd::clamp(own, F(0.0f), F(1.0f)), z);
     }
     // LESS or LEQUAL (the only tests a batch is made for), without a switch.
