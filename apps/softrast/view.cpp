@@ -213,7 +213,7 @@ constexpr std::array<DebugView, 5> kDebugCycle = {DebugView::kNone, DebugView::k
                                                   DebugView::kOverdraw, DebugView::kCost,
                                                   DebugView::kTriangles};
 constexpr int kWarmupFrames = 2;
-constexpr uint32_t kIdlePollMs = 4;  // how often an idle viewer looks for input
+constexpr uint32_t kIdlePollMs = 4;       // how often an idle viewer looks for input
 constexpr double kTitleIntervalS = 0.25;  // the heads-up line is refreshed at most this often
 
 template <class T, size_t N>
