@@ -20,9 +20,10 @@
 //   static constexpr bool kDiscards = true;     // a wide shader that calls f.discard()
 // A wide shader that neither writes depth nor discards lets opaque depth-tested draws resolve
 // visibility first and shade each visible pixel once (deferred shading in tiles). One that also
-// never reads derivatives (f.ddx, f.ddy, sampling with them) in a draw may say so:
+// never reads derivatives (f.ddx, f.ddy, sampling with them) in a draw, and whose every pixel's
+// colour depends on that pixel's inputs alone (no value combined across lanes), may say so:
 //   bool reads_derivatives() const { return false; }
-// and a 4x4 block whose pixels several triangles won is then shaded in one call, each pixel
+// and a 4x4 block whose pixels several triangles cover is then shaded in one call, each pixel
 // with its own triangle's varyings (a 2x2 quad may mix triangles, so ddx and ddy would be
 // meaningless there: they stop the program with a message if called after all). A shader whose
 // fragment work is only a few operations (the built-in Gouraud copies its varyings) gains nothing
