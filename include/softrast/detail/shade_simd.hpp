@@ -27,7 +27,7 @@
 namespace softrast {
 
 namespace detail {
-[[noreturn]] void undeclared_derivatives();
+[[noreturn]] inline void undeclared_derivatives();  // defined below
 }  // namespace detail
 
 // What a wide fragment shader sees of one 4x4 block, and what it writes. Lane i is the pixel
@@ -296,8 +296,8 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
 }
 
 // Shades a block whose pixels several triangles of one facing cover (MixedBlock) with shader S
-// on N-lane vectors. Each lane takes its own triangle's plane coefficients, selected per winner,
-// and then runs shade_block_wide's operations in the same order: every pixel gets the bits its
+// on N-lane vectors. Each lane looks its own triangle's plane coefficients up, and then runs
+// shade_block_wide's operations in the same order: every pixel gets the bits its
 // triangle's own call would give it. Resolved (deferred tiles): the pixels are the ones each
 // triangle won, and their depth is already in the framebuffer (the value that call would
 // compute). Otherwise (immediate tiles, BlockBatch): the triangles cover disjoint pixels, and
