@@ -582,7 +582,7 @@ alignas(64) inline constexpr int32_t kLaneColumn[kLanes] = {0, 1, 2, 3, 0, 1, 2,
 alignas(64) inline constexpr int32_t kLaneRow[kLanes] = {0, 0, 0, 0, 1, 1, 1, 1,
                                                          2, 2, 2, 2, 3, 3, 3, 3};
 // The lane of the top-left pixel of each lane's 2x2 quad (lane & ~(1 | 4)).
-alignas(64) inline constexpr int32_t kLaneQuadTopLeft[kLanes] = {0, 0, 2, 2, 0, 0, 2, 2,
+alignas(64) inline constexpr int32_t kLaneQuadTopLeft[kLanes] = {0, 0, 2,  2,  0, 0, 2,  2,
                                                                  8, 8, 10, 10, 8, 8, 10, 10};
 
 // The lane mask of a 16-bit block mask. Masks are read by their sign bit everywhere (select,
