@@ -373,24 +373,30 @@ Buffers render_wide(const Scene& scene, RenderState state, int threads, bool ref
   return read_back(fb);
 }
 
+// `scene` drawn with Shader on the binned path, at every SIMD level the machine has and on 1 and
+// 2 threads, equals the reference path's image bit for bit.
+template <class Shader>
+void expect_wide_as_reference(const Scene& scene, const RenderState& state, const char* label) {
+  Buffers reference = render_wide<Shader>(scene, state, 1, true);
+  SimdLevel cap = simd_level();
+  for (int level = 0; level <= int(cap); ++level) {
+    set_simd_level(SimdLevel(level));
+    for (int threads : {1, 2}) {
+      EXPECT_TRUE(render_wide<Shader>(scene, state, threads, false) == reference)
+          << label << ", threads " << threads << ", " << simd_level_name(SimdLevel(level));
+    }
+  }
+  set_simd_level(cap);
+}
+
 // Small triangles of both facings, alone (immediate tiles) and under large ones (deferred tiles),
 // against the reference path, bit for bit, at every level and on 1 and 2 threads.
 TEST(Deferred, WideShaderWithDerivativesEqualsReference) {
   for (bool with_large : {false, true}) {
     Scene scene = small_triangle_scene(with_large, 7);
     for (DepthFunc func : {DepthFunc::kLess, DepthFunc::kLessEqual}) {
-      RenderState state = opaque_state(func);
-      Buffers reference = render_wide(scene, state, 1, true);
-      SimdLevel cap = simd_level();
-      for (int level = 0; level <= int(cap); ++level) {
-        set_simd_level(SimdLevel(level));
-        for (int threads : {1, 2}) {
-          EXPECT_TRUE(render_wide(scene, state, threads, false) == reference)
-              << (with_large ? "with large triangles" : "one layer") << ", threads " << threads
-              << ", " << simd_level_name(SimdLevel(level));
-        }
-      }
-      set_simd_level(cap);
+      expect_wide_as_reference<WideProbeShader>(scene, opaque_state(func),
+                                                with_large ? "with large triangles" : "one layer");
     }
   }
 }
@@ -402,18 +408,8 @@ TEST(Deferred, WideShaderWithoutDerivativesShadesMixedBlocksAsReference) {
   for (bool with_large : {false, true}) {
     Scene scene = small_triangle_scene(with_large, 9);
     for (DepthFunc func : {DepthFunc::kLess, DepthFunc::kLessEqual}) {
-      RenderState state = opaque_state(func);
-      Buffers reference = render_wide<MixedProbeShader>(scene, state, 1, true);
-      SimdLevel cap = simd_level();
-      for (int level = 0; level <= int(cap); ++level) {
-        set_simd_level(SimdLevel(level));
-        for (int threads : {1, 2}) {
-          EXPECT_TRUE(render_wide<MixedProbeShader>(scene, state, threads, false) == reference)
-              << (with_large ? "with large triangles" : "one layer") << ", threads " << threads
-              << ", " << simd_level_name(SimdLevel(level));
-        }
-      }
-      set_simd_level(cap);
+      expect_wide_as_reference<MixedProbeShader>(scene, opaque_state(func),
+                                                 with_large ? "with large triangles" : "one layer");
     }
   }
 }
@@ -449,17 +445,7 @@ Scene scattered_small_triangles(int count, unsigned seed) {
 TEST(Deferred, BatchedSmallTrianglesInImmediateTilesEqualReference) {
   Scene scene = scattered_small_triangles(3000, 5);
   for (DepthFunc func : {DepthFunc::kLess, DepthFunc::kLessEqual}) {
-    RenderState state = opaque_state(func);
-    Buffers reference = render_wide<MixedProbeShader>(scene, state, 1, true);
-    SimdLevel cap = simd_level();
-    for (int level = 0; level <= int(cap); ++level) {
-      set_simd_level(SimdLevel(level));
-      for (int threads : {1, 2}) {
-        EXPECT_TRUE(render_wide<MixedProbeShader>(scene, state, threads, false) == reference)
-            << "threads " << threads << ", " << simd_level_name(SimdLevel(level));
-      }
-    }
-    set_simd_level(cap);
+    expect_wide_as_reference<MixedProbeShader>(scene, opaque_state(func), "scattered");
   }
 }
 
