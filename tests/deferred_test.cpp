@@ -449,6 +449,49 @@ TEST(Deferred, BatchedSmallTrianglesInImmediateTilesEqualReference) {
   }
 }
 
+// A mesh of medium triangles (quads about 13 x 11 pixels at 301 x 187, cut in two) of random
+// facing at one depth, with larger triangles (15 to 40 pixels) drawn among them, half at that
+// depth exactly (ties), half nearer or farther: one layer, so most tiles are shaded immediately,
+// where the edge blocks of every triangle are held (BlockBatch) and completed by the next ones.
+Scene mesh_with_overlaps(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  auto color = [&] { return glm::vec4(unit(rng), unit(rng), unit(rng), 1.0f); };
+  auto at = [](float x, float y, float z) { return glm::vec4(x, y, z, 1.0f); };
+  Scene scene;
+  constexpr int kColumns = 23, kRows = 17;
+  const float shared = 0.25f;
+  for (int j = 0; j < kRows; ++j) {
+    for (int i = 0; i < kColumns; ++i) {
+      float x0 = -1.0f + 2.0f * i / kColumns, x1 = -1.0f + 2.0f * (i + 1) / kColumns;
+      float y0 = -1.0f + 2.0f * j / kRows, y1 = -1.0f + 2.0f * (j + 1) / kRows;
+      glm::vec4 a = at(x0, y0, shared), b = at(x1, y0, shared), c = at(x1, y1, shared),
+                d = at(x0, y1, shared);
+      if (unit(rng) < 0.5f) std::swap(b, d);  // the other winding: the other facing
+      scene.triangle(a, b, c, color());
+      if (unit(rng) < 0.5f) std::swap(a, c);
+      scene.triangle(a, c, d, color());
+      if ((j * kColumns + i) % 9 == 4) {  // a larger triangle among the mesh's
+        float cx = -1.0f + 2.0f * unit(rng), cy = -1.0f + 2.0f * unit(rng);
+        float size = (15.0f + 25.0f * unit(rng)) / 187.0f;
+        float z = unit(rng) < 0.5f ? shared : shared + 0.2f * (unit(rng) - 0.5f);
+        glm::vec4 v[3];
+        for (glm::vec4& p : v)
+          p = at(cx + size * (unit(rng) - 0.5f), cy + size * (unit(rng) - 0.5f), z);
+        scene.triangle(v[0], v[1], v[2], color());
+      }
+    }
+  }
+  return scene;
+}
+
+TEST(Deferred, HeldEdgeBlocksOfAMeshInImmediateTilesEqualReference) {
+  Scene scene = mesh_with_overlaps(11);
+  for (DepthFunc func : {DepthFunc::kLess, DepthFunc::kLessEqual}) {
+    expect_wide_as_reference<MixedProbeShader>(scene, opaque_state(func), "mesh");
+  }
+}
+
 // A shader that says it reads no derivatives and calls ddx stops with a message instead of
 // shading with differences across triangles.
 TEST(DeferredDeathTest, DerivativesInAMixedBlockStopWithAMessage) {

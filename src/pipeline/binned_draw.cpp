@@ -260,8 +260,8 @@ class BinnedDraw {
     job.program = &program_;
     job.target = &target_;
     Shading shading(program_, target_);
-    // Blocks of small triangles several at a time (block_batch.hpp), where deferred shading's
-    // conditions hold and the shader reads no derivatives.
+    // Blocks that several triangles cover, shaded several triangles at a time (block_batch.hpp),
+    // where deferred shading's conditions hold and the shader reads no derivatives.
     std::optional<BlockBatch> batch;
     if (deferred_ && program_.shade_mixed != nullptr) job.batch = &batch.emplace(program_, target_);
     for (const Chunk& chunk : chunks()) {

@@ -16,6 +16,7 @@ void BlockBatch::add(const Interpolants& in, int x, int y, uint32_t mask) {
     held.winner[held.count] = &in;
     held.mask[held.count++] = mask;  // at most 16: the masks are disjoint and not empty
     slot.covered |= mask;
+    if (slot.covered == 0xffffu) shade(slot);  // complete: nothing more can join
     return;
   }
   if (held.count != 0) shade(slot);

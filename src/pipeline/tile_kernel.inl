@@ -246,15 +246,8 @@ struct BlockTarget {
   const TriRecord& rec;
   DepthTerms depth;
 
-  // Immediate with a batch: whether the triangle is small enough (its area inside the tile at
-  // most kBatchedExtent pixels each way) for its blocks to be held for the batch.
-  static constexpr int kBatchedExtent = 8;
-  bool batched = false;
-
   BlockTarget(TileJob& j, const TriRecord& r, int32_t id, const PixelRect& area) : job(j), rec(r) {
-    if constexpr (kMode == Mode::kImmediate) {
-      batched = area.x1 - area.x0 <= kBatchedExtent && area.y1 - area.y0 <= kBatchedExtent;
-    } else {
+    if constexpr (kMode != Mode::kImmediate) {
       depth_terms(r.interp(), id, area.x0 & ~(kBlockSize - 1), area.x1, area.y0 & ~(kBlockSize - 1),
                   area.y1, depth);
     }
@@ -262,11 +255,7 @@ struct BlockTarget {
   [[gnu::always_inline]] void operator()(int x, int y, uint32_t bits) {
     if constexpr (kMode == Mode::kImmediate) {
       if (job.batch != nullptr) {
-        if (batched) {
-          job.batch->add(rec.interp(), x, y, bits);
-        } else {
-          job.batch->shade_now(rec.interp(), x, y, bits);
-        }
+        job.batch->add(rec.interp(), x, y, bits);
       } else {
         job.program->shade_block(job.program->shader, *job.target, rec.interp(), x, y, bits);
       }
