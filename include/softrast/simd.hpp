@@ -463,6 +463,25 @@ inline void lookup16(const float* table, const Native<4>::I& index, Native<4>::F
       _mm512_maskz_permutexvar_ps(__mmask16(0xffff), __m512i(index), _mm512_loadu_ps(table)));
 }
 
+// Each lane as two int16 halves: (a * b + 2^14) >> 15 half by half, the product rounded to 15
+// fraction bits (PMULHRSW, which SSE2 lacks: there the same integers from the product's halves).
+// Neither product may be (-2^15)^2.
+inline void mul_round15(const Native<4>::I& a, const Native<4>::I& b, Native<4>::I& r) {
+  // With p = hi * 2^16 + lo (lo unsigned), (p + 2^14) >> 15 = 2 hi + ((lo >> 1) + 2^13) >> 14.
+  __m128i x = __m128i(a), y = __m128i(b);
+  __m128i hi = _mm_mulhi_epi16(x, y), lo = _mm_mullo_epi16(x, y);
+  __m128i carry = _mm_srli_epi16(_mm_add_epi16(_mm_srli_epi16(lo, 1), _mm_set1_epi16(0x2000)), 14);
+  r = Native<4>::I(_mm_add_epi16(_mm_add_epi16(hi, hi), carry));
+}
+[[gnu::target("avx2")]] inline void mul_round15(const Native<8>::I& a, const Native<8>::I& b,
+                                                Native<8>::I& r) {
+  r = Native<8>::I(_mm256_mulhrs_epi16(__m256i(a), __m256i(b)));
+}
+[[gnu::target("avx512bw")]] inline void mul_round15(const Native<16>::I& a, const Native<16>::I& b,
+                                                    Native<16>::I& r) {
+  r = Native<16>::I(_mm512_mulhrs_epi16(__m512i(a), __m512i(b)));
+}
+
 // lo[i] = base[index[i]] and hi[i] = base[index[i] + 1]: two neighbouring 32-bit elements per
 // lane with one 64-bit load (half the loads of two gathers).
 inline void gather_pair(const int32_t* base, const Native<4>::I& index, Native<4>::I& lo,

@@ -154,6 +154,30 @@ class Texture {
   // first use and kept: the built-in shaders ask it in every frame.
   bool translucent() const;
 
+  // GL_LINEAR of four RGBA8 texels (b0, b1: the lower row, t0, t1: the upper one) at fractions
+  // fx, fy in [0, 1), in fixed point as the wide samplers compute it with 16-bit lanes (so every
+  // path gives the same bits): levels with 7 fraction bits (255 * 128 at most), weights with 15
+  // (filter_weight), each blend a + (b - a) * w rounded to the nearest 1/128 of a level
+  // (mul_round15): each blend is off by at most 255 / 32768 + 1 / 256 of a level (0.024 for the
+  // two), and where a weight is 0 a texel comes back as texel() gives it, bit for bit.
+  static int filter_weight(float f) {
+    int w = int(f * 32768.0f + 0.5f);
+    return w < 32767 ? w : 32767;
+  }
+  static int mul_round15(int d, int w) { return (d * w + 16384) >> 15; }
+  static glm::vec4 filter_rgba8(const uint8_t* b0, const uint8_t* b1, const uint8_t* t0,
+                                const uint8_t* t1, float fx, float fy) {
+    const int x = filter_weight(fx), y = filter_weight(fy);
+    glm::vec4 out;
+    for (int c = 0; c < 4; ++c) {
+      int bottom = (b0[c] << 7) + mul_round15((b1[c] - b0[c]) << 7, x);
+      int top = (t0[c] << 7) + mul_round15((t1[c] - t0[c]) << 7, x);
+      int v = bottom + mul_round15(top - bottom, y);
+      out[c] = (float(v) * (1.0f / 128.0f)) * (1.0f / 255.0f);
+    }
+    return out;
+  }
+
   // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
   static int wrap(Wrap mode, int i, int size);
   // wrap() of `count` indices in place, index k within sizes[k] (out of line: the wide samplers'
@@ -266,6 +290,12 @@ inline glm::vec4 Texture::sample_bilinear(const Sampler& s, glm::vec2 uv, int le
   int i0 = wrap(s.wrap_u, x0, l.width), i1 = wrap(s.wrap_u, x0 + 1, l.width);
   int j0 = wrap(s.wrap_v, y0, l.height), j1 = wrap(s.wrap_v, y0 + 1, l.height);
   bool d = decodes(s);
+  if (!d) {
+    auto at = [&](int i, int j) {
+      return &texels_[(l.offset + size_t(j) * size_t(l.width) + size_t(i)) * 4];
+    };
+    return filter_rgba8(at(i0, j0), at(i1, j0), at(i0, j1), at(i1, j1), fx, fy);
+  }
   glm::vec4 bottom = level_texel(l, i0, j0, d) * (1.0f - fx) + level_texel(l, i1, j0, d) * fx;
   glm::vec4 top = level_texel(l, i0, j1, d) * (1.0f - fx) + level_texel(l, i1, j1, d) * fx;
   return bottom * (1.0f - fy) + top * fy;

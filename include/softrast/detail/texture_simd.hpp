@@ -86,6 +86,53 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> unpack_texel(const simd::Int<N>& texel, bool 
           simd::to_float((texel >> 16) & byte) * k, simd::to_float(texel >> 24) * k};
 }
 
+// Texture::filter_weight, lane by lane (a named function: see pack_channel in shade_simd.hpp).
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Int<N> filter_weight(const simd::Float<N>& f) {
+  simd::Int<N> w = simd::to_int(f * simd::Float<N>(32768.0f) + simd::Float<N>(0.5f));
+  return simd::select(w > simd::Int<N>(32767), simd::Int<N>(32767), w);
+}
+
+// GL_LINEAR of four RGBA8 texels per lane (b0, b1: the lower row, t0, t1: the upper one),
+// Texture::filter_rgba8's integers: the channels in the 16-bit halves of each lane (red and blue,
+// then green and alpha), blended by simd::isa::mul_round15 (PMULHRSW).
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> filter_rgba8(const simd::Int<N>& b0, const simd::Int<N>& b1,
+                                                const simd::Int<N>& t0, const simd::Int<N>& t1,
+                                                const simd::Float<N>& fx,
+                                                const simd::Float<N>& fy) {
+  using I = simd::Int<N>;
+  using V = typename simd::Native<N>::I;
+  using Fn = typename simd::Native<N>::F;
+  typedef int16_t H __attribute__((vector_size(sizeof(V))));
+  const I wx = filter_weight<N>(fx), wy = filter_weight<N>(fy);
+  simd::Vec4<N> out;
+  for (int k = 0; k < I::kParts; ++k) {
+    const V x = wx.p[k] | (wx.p[k] << 16), y = wy.p[k] | (wy.p[k] << 16);  // in both halves
+    const V even = V{} + 0x00ff00ff;
+    for (int half = 0; half < 2; ++half) {  // red and blue, then green and alpha
+      const int s = 8 * half;
+      // Levels with 7 fraction bits: at most 255 * 128 = 32640, so differences fit in int16.
+      H lb = H(((b0.p[k] >> s) & even) << 7), rb = H(((b1.p[k] >> s) & even) << 7);
+      H lt = H(((t0.p[k] >> s) & even) << 7), rt = H(((t1.p[k] >> s) & even) << 7);
+      V d;
+      simd::isa::mul_round15(V(rb - lb), x, d);
+      H bottom = lb + H(d);
+      simd::isa::mul_round15(V(rt - lt), x, d);
+      H top = lt + H(d);
+      simd::isa::mul_round15(V(top - bottom), y, d);
+      V v = V(bottom + H(d));
+      // v / 128 is exact, and then the same multiplication as Texture::texel's.
+      const Fn to_level = Fn{} + 1.0f / 128.0f, k255 = Fn{} + 1.0f / 255.0f;
+      Fn low = (__builtin_convertvector(v & 0xffff, Fn) * to_level) * k255;
+      Fn high = (__builtin_convertvector(v >> 16, Fn) * to_level) * k255;
+      (half == 0 ? out.x : out.y).p[k] = low;
+      (half == 0 ? out.z : out.w).p[k] = high;
+    }
+  }
+  return out;
+}
+
 // Texel (i, j) of the level whose size and first texel are (w, h, offset), lane by lane.
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> fetch(const Texture& t, const simd::Int<N>& i,
@@ -134,9 +181,17 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_level(const Texture& t, const Sampler&
     I b0, b1, t0, t1;
     simd::gather_pair<N>(texels, offset + j0 * w + i0, b0, b1);
     simd::gather_pair<N>(texels, offset + j1 * w + i0, t0, t1);
+    if (!d) return filter_rgba8<N>(b0, b1, t0, t1, fx, fy);
     simd::Vec4<N> bottom = lerp<N>(unpack_texel<N>(b0, d), unpack_texel<N>(b1, d), fx);
     simd::Vec4<N> top = lerp<N>(unpack_texel<N>(t0, d), unpack_texel<N>(t1, d), fx);
     return lerp<N>(bottom, top, fy);
+  }
+  if (!d) {
+    const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
+    return filter_rgba8<N>(simd::gather<N>(texels, offset + j0 * w + i0),
+                           simd::gather<N>(texels, offset + j0 * w + i1),
+                           simd::gather<N>(texels, offset + j1 * w + i0),
+                           simd::gather<N>(texels, offset + j1 * w + i1), fx, fy);
   }
   simd::Vec4<N> bottom =
       lerp<N>(fetch<N>(t, i0, j0, w, offset, d), fetch<N>(t, i1, j0, w, offset, d), fx);
