@@ -24,7 +24,6 @@
 #include <atomic>
 #include <chrono>
 #include <memory>
-#include <optional>
 #include <span>
 #include <vector>
 
@@ -58,6 +57,7 @@ struct alignas(64) Chunk {
 // A tile worker's scratch for deferred tiles.
 struct DeferredScratch {
   TileVisibility visibility;
+  BlockBatch batch;                          // immediate tiles' held blocks (empty between tiles)
   std::vector<const Interpolants*> interps;  // by id: the tile's triangles in submission order
 };
 
@@ -221,7 +221,7 @@ class BinnedDraw {
         if (deferred_ && worth_deferring(tile)) {
           resolve_and_shade_tile(tile, *cache_.scratch[worker]);
         } else {
-          raster_tile(tile);
+          raster_tile(tile, deferred_ ? cache_.scratch[worker].get() : nullptr);
         }
         if (state_.tile_times) {  // the `cost` debug view; one thread owns the tile
           std::chrono::duration<double> spent = std::chrono::steady_clock::now() - start;
@@ -254,7 +254,7 @@ class BinnedDraw {
 
   // Phase 2, immediate shading: every block of every triangle goes to the fragment stage as it
   // is rasterized.
-  void raster_tile(size_t tile) {
+  void raster_tile(size_t tile, DeferredScratch* scratch) {
     TileJob job;
     job.region = tile_region(tile);
     job.program = &program_;
@@ -262,8 +262,11 @@ class BinnedDraw {
     Shading shading(program_, target_);
     // Blocks that several triangles cover, shaded several triangles at a time (block_batch.hpp),
     // where deferred shading's conditions hold and the shader reads no derivatives.
-    std::optional<BlockBatch> batch;
-    if (deferred_ && program_.shade_mixed != nullptr) job.batch = &batch.emplace(program_, target_);
+    BlockBatch* batch = nullptr;
+    if (scratch != nullptr && program_.shade_mixed != nullptr) {
+      batch = job.batch = &scratch->batch;
+      batch->begin(program_, target_);
+    }
     for (const Chunk& chunk : chunks()) {
       const std::vector<uint32_t>& bin = chunk.bins[tile];
       if (bin.empty()) continue;

@@ -9,7 +9,7 @@ void BlockBatch::add(const Interpolants& in, int x, int y, uint32_t mask) {
   bool same_block = held.count != 0 && slot.x == x && slot.y == y;
   if (mask == 0xffffu) {  // a whole block: nothing to share it with
     if (same_block) shade(slot);
-    program_.shade_block(program_.shader, target_, in, x, y, mask);
+    program_->shade_block(program_->shader, *target_, in, x, y, mask);
     return;
   }
   if (same_block && (slot.covered & mask) == 0 && held.front_facing == in.front_facing) {
@@ -38,9 +38,10 @@ void BlockBatch::flush() {
 void BlockBatch::shade(Slot& slot) {
   const MixedBlock& held = slot.block;
   if (held.count == 1) {
-    program_.shade_block(program_.shader, target_, *held.winner[0], slot.x, slot.y, held.mask[0]);
+    program_->shade_block(program_->shader, *target_, *held.winner[0], slot.x, slot.y,
+                          held.mask[0]);
   } else {
-    program_.shade_mixed(program_.shader, target_, held, slot.x, slot.y);
+    program_->shade_mixed(program_->shader, *target_, held, slot.x, slot.y);
   }
   slot.block.count = 0;
 }

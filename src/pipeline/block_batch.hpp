@@ -23,12 +23,17 @@ namespace softrast::detail {
 
 class BlockBatch {
  public:
-  BlockBatch(const FragmentProgram& program, const ShadeTarget& target)
-      : program_(program), target_(target) {}
+  BlockBatch() = default;
   ~BlockBatch() { flush(); }  // in case the owner did not: held pixels are never dropped
   BlockBatch(const BlockBatch&) = delete;
   BlockBatch& operator=(const BlockBatch&) = delete;
 
+  // Starts a tile of a draw (the batch is kept from tile to tile, so that its slots are not
+  // built again for each: it holds nothing between tiles).
+  void begin(const FragmentProgram& program, const ShadeTarget& target) {
+    program_ = &program;
+    target_ = &target;
+  }
   // The pixels `mask` of the block at (x, y), covered by the triangle of `in`: held for a call
   // with other triangles' pixels of that block, or shaded now if they are the whole block (after
   // the block's held pixels, if any).
@@ -38,7 +43,8 @@ class BlockBatch {
 
  private:
   // Held blocks, one slot per block of a tile (a block always goes to the same slot, so it is
-  // never held twice; blocks of other tiles would share slots, but a batch serves one tile).
+  // never held twice; blocks of other tiles would share slots, but a batch serves one tile at a
+  // time).
   struct Slot {
     int x = 0, y = 0;
     uint32_t covered = 0;  // the union of block.mask
@@ -50,8 +56,8 @@ class BlockBatch {
   }
   void shade(Slot& slot);
 
-  const FragmentProgram& program_;
-  const ShadeTarget& target_;
+  const FragmentProgram* program_ = nullptr;
+  const ShadeTarget* target_ = nullptr;
   Slot slots_[kSide * kSide];
 };
 
