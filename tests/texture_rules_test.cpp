@@ -166,55 +166,6 @@ TEST(TextureRules, BilinearExactAtCentresAndWithinOneLevelOfTheDoubleReference) 
   EXPECT_LT(worst, 0.024 / 255.0);
 }
 
-// The sampling kernel of every SIMD level the CPU has (4 lanes at the baseline, 8 with AVX2, 16
-// with AVX-512: each computes the fixed-point filter its own way) gives the scalar sampler's bits,
-// bilinear and trilinear, every wrap mode, power-of-two sizes and others, linear and sRGB.
-TEST(TextureRules, EveryLevelsKernelGivesTheScalarSamplersBits) {
-  using Kernel = void (*)(const Texture&, const Sampler&, detail::SampleLanes&, bool);
-  std::vector<Kernel> kernels = {&detail::sample_lanes_4};
-  if (cpu_simd_level() >= SimdLevel::kAvx2) kernels.push_back(&detail::sample_lanes_8);
-  if (cpu_simd_level() >= SimdLevel::kAvx512) kernels.push_back(&detail::sample_lanes_16);
-  std::mt19937 rng(23);
-  std::uniform_real_distribution<float> coordinate(-3.0f, 3.0f), derivative(-0.05f, 0.05f);
-  int compared = 0;
-  for (auto [w, h] : {std::pair{64, 32}, std::pair{13, 16}, std::pair{7, 5}}) {
-    for (ColorSpace space : {ColorSpace::kLinear, ColorSpace::kSrgb}) {
-      Texture t = Texture::from_image(noise_image(w, h, unsigned(w * 3 + h)), space);
-      for (Wrap wrap : kWraps) {
-        for (Filter filter : {Filter::kBilinear, Filter::kTrilinear}) {
-          Sampler s{filter, wrap, wrap};
-          s.srgb_decode = true;
-          const bool derivatives = filter == Filter::kTrilinear;
-          for (int n = 0; n < 32; ++n) {
-            detail::SampleLanes io;
-            for (int k = 0; k < 16; ++k) {
-              io.in[0][k] = coordinate(rng), io.in[1][k] = coordinate(rng);
-              for (int d = 2; d < 6; ++d) io.in[d][k] = derivative(rng);
-            }
-            for (size_t level = 0; level < kernels.size(); ++level) {
-              SCOPED_TRACE(name_of(w, h, wrap) + " filter " + std::to_string(int(filter)) +
-                           " srgb " + std::to_string(int(space)) + " kernel " +
-                           std::to_string(level));
-              detail::SampleLanes lanes = io;
-              kernels[level](t, s, lanes, derivatives);
-              for (int k = 0; k < 16; ++k) {
-                glm::vec2 uv(io.in[0][k], io.in[1][k]);
-                glm::vec4 want = derivatives ? t.sample(s, uv, {io.in[2][k], io.in[3][k]},
-                                                        {io.in[4][k], io.in[5][k]})
-                                             : t.sample(s, uv);
-                glm::vec4 got(lanes.out[0][k], lanes.out[1][k], lanes.out[2][k], lanes.out[3][k]);
-                ASSERT_EQ(got, want) << "lane " << k << " at " << uv.x << "," << uv.y;
-                ++compared;
-              }
-            }
-          }
-        }
-      }
-    }
-  }
-  EXPECT_GT(compared, 16 * 32 * 3 * 2 * 3 * 2);
-}
-
 // Around +-1e6 (coordinates whose products with the sizes are exact in float, so that the
 // double reference sees the same point): nearest and bilinear follow the wrap rules there too.
 TEST(TextureRules, WrapModesHoldAtPlusMinusOneMillion) {
