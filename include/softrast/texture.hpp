@@ -154,6 +154,13 @@ class Texture {
   // first use and kept: the built-in shaders ask it in every frame.
   bool translucent() const;
 
+  // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
+  static int wrap(Wrap mode, int i, int size);
+  // wrap() of `count` indices in place, index k within sizes[k] (out of line: the wide samplers'
+  // path for sizes that are not powers of two and for mirrored repeat).
+  static void wrap_lanes(Wrap mode, int32_t* indices, const int32_t* sizes, int count);
+
+ private:
   // GL_LINEAR of four RGBA8 texels (b0, b1: the lower row, t0, t1: the upper one) at fractions
   // fx, fy in [0, 1), in fixed point as the wide samplers compute it with 16-bit lanes (so every
   // path gives the same bits): levels with 7 fraction bits (255 * 128 at most), weights with 15
@@ -170,21 +177,14 @@ class Texture {
     const int x = filter_weight(fx), y = filter_weight(fy);
     glm::vec4 out;
     for (int c = 0; c < 4; ++c) {
-      int bottom = (b0[c] << 7) + mul_round15((b1[c] - b0[c]) << 7, x);
-      int top = (t0[c] << 7) + mul_round15((t1[c] - t0[c]) << 7, x);
+      int bottom = b0[c] * 128 + mul_round15((b1[c] - b0[c]) * 128, x);
+      int top = t0[c] * 128 + mul_round15((t1[c] - t0[c]) * 128, x);
       int v = bottom + mul_round15(top - bottom, y);
       out[c] = (float(v) * (1.0f / 128.0f)) * (1.0f / 255.0f);
     }
     return out;
   }
 
-  // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
-  static int wrap(Wrap mode, int i, int size);
-  // wrap() of `count` indices in place, index k within sizes[k] (out of line: the wide samplers'
-  // path for sizes that are not powers of two and for mirrored repeat).
-  static void wrap_lanes(Wrap mode, int32_t* indices, const int32_t* sizes, int count);
-
- private:
   glm::vec4 sample_nearest(const Sampler& s, glm::vec2 uv, int level) const;
   glm::vec4 sample_bilinear(const Sampler& s, glm::vec2 uv, int level) const;
   glm::vec4 level_texel(const MipLevel& l, int i, int j, bool decode) const {
