@@ -79,6 +79,7 @@ SOFTRAST_AVX512 void cmp(int predicate, const I16& a, const I16& b, I16& r);
 SOFTRAST_AVX512 void blend(const I16& mask, const F16& a, const F16& b, F16& r);
 SOFTRAST_AVX512 void blend(const I16& mask, const I16& a, const I16& b, I16& r);
 SOFTRAST_AVX512 void broadcast(float s, F16& r);
+SOFTRAST_AVX512 void broadcast(int32_t s, I16& r);
 }  // namespace isa
 
 template <int N>
@@ -90,14 +91,14 @@ struct Float {
 
   Float() = default;
   // Broadcast; implicit so that 2.0f * x reads naturally. (Written as a shuffle of lane 0:
-  // GCC 12 builds `V{} + s` lane by lane once it has been inlined into a wider target.)
+  // GCC 12 builds `V{} + s` lane by lane once it has been inlined into a wider target; at 16
+  // lanes the shuffle became two broadcasts, so there it is the intrinsic.)
   SOFTRAST_SIMD_INLINE Float(float s) {
 #if defined(__clang__)  // no __builtin_shuffle; clang broadcasts a scalar added to a vector
     for (int k = 0; k < kParts; ++k) p[k] = V{} + s;
 #else
     if constexpr (N == 16) {
-      // One VBROADCASTSS: the shuffle below became a zero-masked broadcast and a second one.
-      isa::broadcast(s, p[0]);
+      isa::broadcast(s, p[0]);  // one VBROADCASTSS
     } else {
       V t = {};
       t[0] = s;
@@ -173,12 +174,16 @@ struct Int {
 
   Int() = default;
   SOFTRAST_SIMD_INLINE Int(int32_t s) {  // broadcast, as Float's
-    V t = {};
-    t[0] = s;
 #if defined(__clang__)
     for (int k = 0; k < kParts; ++k) p[k] = V{} + s;
 #else
-    for (int k = 0; k < kParts; ++k) p[k] = __builtin_shuffle(t, V{});
+    if constexpr (N == 16) {
+      isa::broadcast(s, p[0]);
+    } else {
+      V t = {};
+      t[0] = s;
+      for (int k = 0; k < kParts; ++k) p[k] = __builtin_shuffle(t, V{});
+    }
 #endif
   }
   SOFTRAST_SIMD_INLINE static Int load(const int32_t* lanes) {
@@ -370,6 +375,9 @@ SOFTRAST_AVX512 void blend(const I16& mask, const F16& a, const F16& b, F16& r) 
 }
 SOFTRAST_AVX512 void broadcast(float s, F16& r) {
   r = F16(_mm512_set1_ps(s));
+}
+SOFTRAST_AVX512 void broadcast(int32_t s, I16& r) {
+  r = I16(_mm512_set1_epi32(s));
 }
 SOFTRAST_AVX512 void blend(const I16& mask, const I16& a, const I16& b, I16& r) {
   r = I16(_mm512_mask_blend_epi32(_mm512_movepi32_mask(__m512i(mask)), __m512i(b), __m512i(a)));

@@ -54,7 +54,8 @@ struct alignas(64) Chunk {
   std::vector<int64_t> box_area;
 };
 
-// A tile worker's scratch for deferred tiles.
+// A tile worker's scratch for the draws that may defer (deferred tiles, and the batch of the
+// immediate ones).
 struct DeferredScratch {
   TileVisibility visibility;
   BlockBatch batch;                          // immediate tiles' held blocks (empty between tiles)
@@ -262,10 +263,9 @@ class BinnedDraw {
     Shading shading(program_, target_);
     // Blocks that several triangles cover, shaded several triangles at a time (block_batch.hpp),
     // where deferred shading's conditions hold and the shader reads no derivatives.
-    BlockBatch* batch = nullptr;
     if (scratch != nullptr && program_.shade_mixed != nullptr) {
-      batch = job.batch = &scratch->batch;
-      batch->begin(program_, target_);
+      job.batch = &scratch->batch;
+      job.batch->begin(program_, target_);
     }
     for (const Chunk& chunk : chunks()) {
       const std::vector<uint32_t>& bin = chunk.bins[tile];
@@ -279,7 +279,7 @@ class BinnedDraw {
         rasterize_triangle_scanline(rec.coverage, job.region, shading.sink(rec.interp()));
       }
     }
-    if (batch) batch->flush();  // the tile's last held blocks
+    if (job.batch != nullptr) job.batch->flush();  // the tile's last held blocks
   }
 
   // Phase 2, deferred shading (tile_visibility.hpp): visibility of all the tile's triangles
