@@ -145,7 +145,12 @@ class BinnedDraw {
     auto add = [&](const WindowVertex& a, const WindowVertex& b, const WindowVertex& c) {
       add_triangle(chunk, a, b, c);
     };
-    for (size_t t = begin; t < end; ++t) cache_.vertices.triangle(geometry_, indices + 3 * t, add);
+    auto keep = [&](int64_t area) {
+      return area != 0 && !is_culled(area, state_.cull, state_.front_face);
+    };
+    for (size_t t = begin; t < end; ++t) {
+      cache_.vertices.triangle(geometry_, indices + 3 * t, keep, add);
+    }
   }
 
   void add_triangle(Chunk& chunk, const WindowVertex& a, const WindowVertex& b,

@@ -65,10 +65,18 @@ class WindowVertices {
   // outside one plane, has a NaN or Inf position or an index out of range.
   template <class Emit>
   void triangle(const GeometryStage& geometry, const uint32_t* i, Emit&& emit) const {
+    triangle(geometry, i, [](int64_t) { return true; }, emit);
+  }
+  // The same, but a trivially accepted triangle goes to `emit` only if keep(its snapped signed
+  // area, signed_area_fx16) is true: a culled triangle stops before its window vertices are made
+  // (half of a closed mesh). Clipped pieces go to `emit` regardless.
+  template <class Keep, class Emit>
+  void triangle(const GeometryStage& geometry, const uint32_t* i, Keep&& keep, Emit&& emit) const {
     if (!geometry.valid(i[0]) || !geometry.valid(i[1]) || !geometry.valid(i[2])) return;
     static_assert(GeometryStage::kNonFinite < 256, "codes are stored in bytes");
     uint32_t c0 = codes_[i[0]], c1 = codes_[i[1]], c2 = codes_[i[2]];
     if ((c0 | c1 | c2) == 0) {
+      if (!keep(signed_area_fx16(window_[i[0]], window_[i[1]], window_[i[2]]))) return;
       emit(vertex(geometry, i[0]), vertex(geometry, i[1]), vertex(geometry, i[2]));
     } else if (!((c0 | c1 | c2) & GeometryStage::kNonFinite) && !(c0 & c1 & c2)) {
       geometry.triangle(i[0], i[1], i[2], emit);

@@ -64,9 +64,10 @@ struct TriangleSetup : TriangleCoverage {
 };
 
 // Twice the signed area of the snapped triangle, (x1-x0)(y2-y0) - (x2-x0)(y1-y0), exact.
-// In y-down window coordinates it is negative for counter-clockwise triangles.
-inline int64_t signed_area_fx16(const WindowVertex& v0, const WindowVertex& v1,
-                                const WindowVertex& v2) {
+// In y-down window coordinates it is negative for counter-clockwise triangles. V: any vertex with
+// WindowVertex's int32 x and y (16.8 fixed point).
+template <class V>
+int64_t signed_area_fx16(const V& v0, const V& v1, const V& v2) {
   return (int64_t(v1.x) - v0.x) * (int64_t(v2.y) - v0.y) -
          (int64_t(v2.x) - v0.x) * (int64_t(v1.y) - v0.y);
 }
