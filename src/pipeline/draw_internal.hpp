@@ -65,8 +65,8 @@ class WindowVertices {
   // outside one plane, has a NaN or Inf position or an index out of range.
   template <class Emit>
   void triangle(const GeometryStage& geometry, const uint32_t* i, Emit&& emit) const {
-    triangle(
-        geometry, i, [](int64_t) { return true; }, emit);
+    auto every = [](int64_t) { return true; };
+    triangle(geometry, i, every, emit);
   }
   // The same, but a trivially accepted triangle goes to `emit` only if keep(its snapped signed
   // area, signed_area_fx16) is true: a culled triangle stops before its window vertices are made
