@@ -145,19 +145,23 @@ class BinnedDraw {
     auto add = [&](const WindowVertex& a, const WindowVertex& b, const WindowVertex& c) {
       add_triangle(chunk, a, b, c);
     };
-    auto keep = [&](int64_t area) {
-      return area != 0 && !is_culled(area, state_.cull, state_.front_face);
-    };
+    auto keep = [&](int64_t area) { return kept(area); };
     for (size_t t = begin; t < end; ++t) {
       cache_.vertices.triangle(geometry_, indices + 3 * t, keep, add);
     }
   }
 
+  // Whether a triangle of snapped signed area `area` survives culling (zero area never does).
+  bool kept(int64_t area) const {
+    return area != 0 && !is_culled(area, state_.cull, state_.front_face);
+  }
+
   void add_triangle(Chunk& chunk, const WindowVertex& a, const WindowVertex& b,
                     const WindowVertex& c) {
-    // Culling first: half of a closed mesh stops here, before any other work.
+    // Clipped pieces are culled here; accepted triangles were, before their vertices were made
+    // (setup_chunk), and the check passes them again. The area is needed below either way.
     int64_t area = signed_area_fx16(a, b, c);
-    if (area == 0 || is_culled(area, state_.cull, state_.front_face)) return;
+    if (!kept(area)) return;
     uint32_t offset = chunk.records.allocate(record_bytes_);
     // TriRecord is an implicit-lifetime aggregate living in allocated bytes; every field is
     // written below.
