@@ -124,6 +124,15 @@ void expect_sampler_matches_scalar(const Texture& texture, const Sampler& sample
       ASSERT_EQ(got.z.lane(i), want.b);
       ASSERT_EQ(got.w.lane(i), want.a);
     }
+    if (sampler.filter == Filter::kTrilinear) continue;
+    // The packed form (the texture shader's opaque output): the bytes the fragment stage makes of
+    // the scalar sample. Bilinear filtering rounds its 16-bit levels straight to bytes there.
+    simd::Int<N> packed = sample_rgba8<N>(texture, sampler, uv);
+    for (int i = 0; i < simd::kLanes; ++i) {
+      uint32_t want = pack_rgba8(texture.sample(sampler, uvs[first + i]));
+      ASSERT_EQ(uint32_t(packed.lane(i)), want)
+          << "uv " << uvs[first + i].x << "," << uvs[first + i].y;
+    }
   }
 }
 

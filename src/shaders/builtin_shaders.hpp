@@ -112,6 +112,9 @@ struct TextureShader {
   Sampler sampler;
   float alpha = 1.0f;
   bool srgb = false;  // encode the output (the linear workflow)
+  // The draw is opaque: the texel is written as it is, packed by the sampler (sample_rgba8: the
+  // same bytes), where alpha is 1, nothing is encoded and no mip levels are read.
+  bool opaque = false;
   bool reads_derivatives() const { return sampler.filter == Filter::kTrilinear; }
   glm::vec4 vertex(uint32_t i, float* v) const {
     v[0] = in.mesh->uvs[i].x, v[1] = in.mesh->uvs[i].y;
@@ -119,6 +122,10 @@ struct TextureShader {
   }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
+    if (opaque && alpha == 1.0f && !srgb && sampler.filter != Filter::kTrilinear) {
+      f.set_rgba8(sample_rgba8<N>(*texture, sampler, f.vec2(0)));
+      return;
+    }
     simd::Vec4<N> t = sample_with_derivatives(*texture, sampler, f, 0);
     f.color = {t.x, t.y, t.z, t.w * alpha};
     if (srgb) f.color = encode_srgb<N>(f.color);

@@ -120,7 +120,9 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
                   n);
     case ShaderKind::kTexture: {
       const Texture* t = surf.texture ? surf.texture : &kWhite;
-      return draw(fb, state, TextureShader{in, t, sampler, opt.alpha, opt.srgb}, indices, n);
+      TextureShader shader{in, t, sampler, opt.alpha, opt.srgb};
+      shader.opaque = state.blend == BlendMode::kOpaque;
+      return draw(fb, state, shader, indices, n);
     }
     case ShaderKind::kPhong:
     case ShaderKind::kPbr: {  // pbr is drawn by render_pbr; phong if it ever gets here

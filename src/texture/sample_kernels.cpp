@@ -4,6 +4,8 @@
 // has what the kernel needs.
 #include <immintrin.h>
 
+#include "softrast/detail/shade_block.hpp"
+#include "softrast/detail/shade_simd.hpp"  // pack_rgba8
 #include "softrast/detail/texture_simd.hpp"
 
 namespace softrast::detail {
@@ -24,7 +26,39 @@ SOFTRAST_SIMD_INLINE void sample_lanes(const Texture& texture, const Sampler& s,
   c.w.store(io.out[3]);
 }
 
+// sample_rgba8: bilinear without decode filtered straight to bytes, else the float channels
+// packed as the fragment stage packs them.
+template <int N>
+SOFTRAST_SIMD_INLINE void sample_rgba8_lanes(const Texture& texture, const Sampler& s,
+                                             SampleLanes& io) {
+  using F = simd::Float<N>;
+  using I = simd::Int<N>;
+  simd::Vec2<N> uv{F::load(io.in[0]), F::load(io.in[1])};
+  I packed;
+  if (s.filter == Filter::kBilinear && !texture.decodes(s)) {
+    const int w = texture.width(), h = texture.height();
+    I b0, b1, t0, t1;
+    F fx, fy;
+    bilinear_texels<N>(texture, s, uv, I(w), I(h), I(0), (w & (w - 1)) == 0, (h & (h - 1)) == 0, b0,
+                       b1, t0, t1, fx, fy);
+    packed = filter_rgba8_packed<N>(b0, b1, t0, t1, fx, fy);
+  } else {
+    packed = pack_rgba8<N>(sample_inline<N>(texture, s, uv));
+  }
+  packed.store(io.rgba8);
+}
+
 }  // namespace
+
+[[gnu::flatten]] void sample_rgba8_lanes_4(const Texture& texture, const Sampler& s,
+                                           SampleLanes& io) {
+  sample_rgba8_lanes<4>(texture, s, io);
+}
+
+[[gnu::target("avx2"), gnu::flatten]] void sample_rgba8_lanes_8(const Texture& texture,
+                                                                const Sampler& s, SampleLanes& io) {
+  sample_rgba8_lanes<8>(texture, s, io);
+}
 
 [[gnu::flatten]] void sample_lanes_4(const Texture& texture, const Sampler& s, SampleLanes& io,
                                      bool derivatives) {
@@ -95,13 +129,13 @@ SOFTRAST_AVX512_FN Texels16 lerp16(const Texels16& a, const Texels16& b, __m512 
           mix16(a.a, b.a, s, t)};
 }
 
-// sample_level's bilinear branch for one level per lane (size w x h, first texel `offset`);
-// `row_shift` is log2(w) when every lane has that power-of-two width (the rows start at j << it),
-// else -1 (j * w).
-SOFTRAST_AVX512_FN Texels16 bilinear16(const Texture& t, const Sampler& s, __m512 u, __m512 v,
-                                       __m512i w, __m512i h, __m512i offset, bool pow2_u,
-                                       bool pow2_v, int row_shift) {
-  __m512 fx, fy;
+// sample_level's bilinear branch for one level per lane (size w x h, first texel `offset`): the
+// texels (bilinear_texels) and then the filter; `row_shift` is log2(w) when every lane has that
+// power-of-two width (the rows start at j << it), else -1 (j * w).
+SOFTRAST_AVX512_FN void bilinear16_texels(const Texture& t, const Sampler& s, __m512 u, __m512 v,
+                                          __m512i w, __m512i h, __m512i offset, bool pow2_u,
+                                          bool pow2_v, int row_shift, __m512i& b0, __m512i& b1,
+                                          __m512i& t0, __m512i& t1, __m512& fx, __m512& fy) {
   __m512i x0 =
       floor16(_mm512_sub_ps(_mm512_mul_ps(u, _mm512_cvtepi32_ps(w)), _mm512_set1_ps(0.5f)), fx);
   __m512i y0 =
@@ -123,7 +157,6 @@ SOFTRAST_AVX512_FN Texels16 bilinear16(const Texture& t, const Sampler& s, __m51
   row0 = _mm512_add_epi32(offset, row0);
   row1 = _mm512_add_epi32(offset, row1);
   const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
-  __m512i b0, b1, t0, t1;
   if (_mm512_cmpneq_epi32_mask(i1, _mm512_add_epi32(i0, one)) == 0) {
     // No lane wraps between its columns: one 64-bit load per lane and row (sample_level).
     using V = simd::Native<16>::I;
@@ -138,6 +171,14 @@ SOFTRAST_AVX512_FN Texels16 bilinear16(const Texture& t, const Sampler& s, __m51
     t0 = _mm512_i32gather_epi32(_mm512_add_epi32(row1, i0), texels, 4);
     t1 = _mm512_i32gather_epi32(_mm512_add_epi32(row1, i1), texels, 4);
   }
+}
+
+SOFTRAST_AVX512_FN Texels16 bilinear16(const Texture& t, const Sampler& s, __m512 u, __m512 v,
+                                       __m512i w, __m512i h, __m512i offset, bool pow2_u,
+                                       bool pow2_v, int row_shift) {
+  __m512i b0, b1, t0, t1;
+  __m512 fx, fy;
+  bilinear16_texels(t, s, u, v, w, h, offset, pow2_u, pow2_v, row_shift, b0, b1, t0, t1, fx, fy);
   simd::Vec4<16> c = filter_rgba8<16>(as_lanes(b0), as_lanes(b1), as_lanes(t0), as_lanes(t1),
                                       as_lanes(fx), as_lanes(fy));
   return {__m512(c.x.p[0]), __m512(c.y.p[0]), __m512(c.z.p[0]), __m512(c.w.p[0])};
@@ -204,6 +245,24 @@ SOFTRAST_AVX512_FN void filtered16(const Texture& texture, const Sampler& s, Sam
     return;
   }
   sample_lanes<16>(texture, s, io, derivatives);
+}
+
+[[gnu::target("avx512f,avx512bw,avx512dq,avx512vl"), gnu::flatten]] void sample_rgba8_lanes_16(
+    const Texture& texture, const Sampler& s, SampleLanes& io) {
+  if (s.filter == Filter::kBilinear && !texture.decodes(s)) {
+    const int w = texture.width(), h = texture.height();
+    const bool pow2_u = (w & (w - 1)) == 0, pow2_v = (h & (h - 1)) == 0;
+    __m512i b0, b1, t0, t1;
+    __m512 fx, fy;
+    bilinear16_texels(texture, s, _mm512_load_ps(io.in[0]), _mm512_load_ps(io.in[1]),
+                      _mm512_set1_epi32(w), _mm512_set1_epi32(h), _mm512_setzero_si512(), pow2_u,
+                      pow2_v, pow2_u ? __builtin_ctz(unsigned(w)) : -1, b0, b1, t0, t1, fx, fy);
+    filter_rgba8_packed<16>(as_lanes(b0), as_lanes(b1), as_lanes(t0), as_lanes(t1), as_lanes(fx),
+                            as_lanes(fy))
+        .store(io.rgba8);
+    return;
+  }
+  sample_rgba8_lanes<16>(texture, s, io);
 }
 #if !defined(__clang__)
 #pragma GCC diagnostic pop

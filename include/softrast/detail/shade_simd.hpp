@@ -46,6 +46,17 @@ struct Fragments {
   bool several_triangles = false;
   const F* varyings = nullptr;  // the shader's kVaryings values, perspective-correct
   simd::Vec4<N> color;          // the output, set by the shader
+  // Or the output as RGBA8 (red in the low byte), for a shader whose result comes as bytes (the
+  // built-in texture shader writes the filtered texel as it is): set_rgba8 replaces `color`,
+  // which the fragment stage would otherwise clamp, scale and round to these bytes itself.
+  // Blending starts from it as byte / 255.
+  simd::Int<N> rgba8;
+  bool has_rgba8 = false;
+
+  SOFTRAST_SIMD_INLINE void set_rgba8(const simd::Int<N>& packed) {
+    rgba8 = packed;
+    has_rgba8 = true;
+  }
 
   SOFTRAST_SIMD_INLINE F varying(int i) const { return varyings[i]; }
   SOFTRAST_SIMD_INLINE simd::Vec2<N> vec2(int i) const { return {varyings[i], varyings[i + 1]}; }
@@ -286,10 +297,16 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   if (depth_test && depth_write) {
     (live == 0xffffu ? z : simd::select(f.live, z, stored)).store(depth_at);
   }
-  if (live == 0xffffu && blend_mode == BlendMode::kOpaque) {  // the common full block
-    pack_rgba8<N>(f.color).store(color_at);
+  if (blend_mode == BlendMode::kOpaque) {
+    const I packed = f.has_rgba8 ? f.rgba8 : pack_rgba8<N>(f.color);
+    if (live == 0xffffu) {  // the common full block
+      packed.store(color_at);
+    } else {
+      simd::select(f.live, packed, I::load(color_at)).store(color_at);
+    }
     return;
   }
+  if (f.has_rgba8) f.color = unpack_rgba8<N>(f.rgba8);
   I old = I::load(color_at);
   I packed = blend<N>(blend_mode, f.color, old);
   simd::select(f.live, packed, old).store(color_at);
@@ -381,7 +398,7 @@ SOFTRAST_SIMD_INLINE void shade_mixed_wide(const S& shader, const ShadeTarget& t
   if (live != shaded) undeclared_discard();
   if (!target.resolved) simd::select(f.live, z, stored).store(depth_at);
   int32_t* color_at = reinterpret_cast<int32_t*>(fb.color_block(x, y));
-  I packed = pack_rgba8<N>(f.color);
+  I packed = f.has_rgba8 ? f.rgba8 : pack_rgba8<N>(f.color);
   if (live == 0xffffu) {
     packed.store(color_at);
     return;

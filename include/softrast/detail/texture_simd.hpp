@@ -94,8 +94,38 @@ SOFTRAST_SIMD_INLINE simd::Int<N> filter_weight(const simd::Float<N>& f) {
 }
 
 // GL_LINEAR of four RGBA8 texels per lane (b0, b1: the lower row, t0, t1: the upper one),
-// Texture::filter_rgba8's integers: the channels in the 16-bit halves of each lane (red and blue,
-// then green and alpha), blended by simd::isa::mul_round15 (PMULHRSW).
+// Texture::filter_rgba8's integers: the channels in the 16-bit halves of each lane (red and blue
+// in `rb`, green and alpha in `ga`), each a level with 7 fraction bits (0 to 255 * 128), blended
+// by simd::isa::mul_round15 (PMULHRSW).
+template <int N>
+SOFTRAST_SIMD_INLINE void filter_levels(const simd::Int<N>& b0, const simd::Int<N>& b1,
+                                        const simd::Int<N>& t0, const simd::Int<N>& t1,
+                                        const simd::Float<N>& fx, const simd::Float<N>& fy,
+                                        simd::Int<N>& rb, simd::Int<N>& ga) {
+  using I = simd::Int<N>;
+  using V = typename simd::Native<N>::I;
+  typedef int16_t H __attribute__((vector_size(sizeof(V))));
+  const I wx = filter_weight<N>(fx), wy = filter_weight<N>(fy);
+  for (int k = 0; k < I::kParts; ++k) {
+    const V x = wx.p[k] | (wx.p[k] << 16), y = wy.p[k] | (wy.p[k] << 16);  // in both halves
+    const V even = V{} + 0x00ff00ff;
+    for (int half = 0; half < 2; ++half) {  // red and blue, then green and alpha
+      const int s = 8 * half;
+      // Levels with 7 fraction bits: at most 255 * 128 = 32640, so differences fit in int16.
+      H lb = H(((b0.p[k] >> s) & even) << 7), rb_ = H(((b1.p[k] >> s) & even) << 7);
+      H lt = H(((t0.p[k] >> s) & even) << 7), rt = H(((t1.p[k] >> s) & even) << 7);
+      V d;
+      simd::isa::mul_round15(V(rb_ - lb), x, d);
+      H bottom = lb + H(d);
+      simd::isa::mul_round15(V(rt - lt), x, d);
+      H top = lt + H(d);
+      simd::isa::mul_round15(V(top - bottom), y, d);
+      (half == 0 ? rb : ga).p[k] = V(bottom + H(d));
+    }
+  }
+}
+
+// filter_levels as channels in [0, 1]: Texture::filter_rgba8's result.
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> filter_rgba8(const simd::Int<N>& b0, const simd::Int<N>& b1,
                                                 const simd::Int<N>& t0, const simd::Int<N>& t1,
@@ -104,24 +134,12 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> filter_rgba8(const simd::Int<N>& b0, const si
   using I = simd::Int<N>;
   using V = typename simd::Native<N>::I;
   using Fn = typename simd::Native<N>::F;
-  typedef int16_t H __attribute__((vector_size(sizeof(V))));
-  const I wx = filter_weight<N>(fx), wy = filter_weight<N>(fy);
+  I rb, ga;
+  filter_levels<N>(b0, b1, t0, t1, fx, fy, rb, ga);
   simd::Vec4<N> out;
   for (int k = 0; k < I::kParts; ++k) {
-    const V x = wx.p[k] | (wx.p[k] << 16), y = wy.p[k] | (wy.p[k] << 16);  // in both halves
-    const V even = V{} + 0x00ff00ff;
-    for (int half = 0; half < 2; ++half) {  // red and blue, then green and alpha
-      const int s = 8 * half;
-      // Levels with 7 fraction bits: at most 255 * 128 = 32640, so differences fit in int16.
-      H lb = H(((b0.p[k] >> s) & even) << 7), rb = H(((b1.p[k] >> s) & even) << 7);
-      H lt = H(((t0.p[k] >> s) & even) << 7), rt = H(((t1.p[k] >> s) & even) << 7);
-      V d;
-      simd::isa::mul_round15(V(rb - lb), x, d);
-      H bottom = lb + H(d);
-      simd::isa::mul_round15(V(rt - lt), x, d);
-      H top = lt + H(d);
-      simd::isa::mul_round15(V(top - bottom), y, d);
-      V v = V(bottom + H(d));
+    for (int half = 0; half < 2; ++half) {
+      const V v = (half == 0 ? rb : ga).p[k];
       // v / 128 is exact, and then the same multiplication as Texture::texel's.
       const Fn to_level = Fn{} + 1.0f / 128.0f, k255 = Fn{} + 1.0f / 255.0f;
       Fn low = (__builtin_convertvector(v & 0xffff, Fn) * to_level) * k255;
@@ -131,6 +149,22 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> filter_rgba8(const simd::Int<N>& b0, const si
     }
   }
   return out;
+}
+
+// filter_levels packed as RGBA8, exactly what pack_rgba8 (shade_simd.hpp) makes of filter_rgba8's
+// channels: for a level v, trunc(min(max((v / 128) / 255, 0), 1) * 255 + 0.5) in float is
+// (v + 64) >> 7 (v / 128 rounded half up) for every v from 0 to 255 * 128, which the sampler
+// tests confirm lane by lane. Both channels of a lane at once: no carry crosses the halves (v +
+// 64 < 2^15), and the mask drops what the shift brings down from the upper half.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Int<N> filter_rgba8_packed(
+    const simd::Int<N>& b0, const simd::Int<N>& b1, const simd::Int<N>& t0, const simd::Int<N>& t1,
+    const simd::Float<N>& fx, const simd::Float<N>& fy) {
+  using I = simd::Int<N>;
+  I rb, ga;
+  filter_levels<N>(b0, b1, t0, t1, fx, fy, rb, ga);
+  const I round(0x00400040), bytes(0x00ff00ff);
+  return (((rb + round) >> 7) & bytes) | ((((ga + round) >> 7) & bytes) << 8);
 }
 
 // Texel (i, j) of the level whose size and first texel are (w, h, offset), lane by lane.
@@ -147,6 +181,39 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> lerp(const simd::Vec4<N>& a, const simd::Vec4
                                         const simd::Float<N>& t) {
   simd::Float<N> s = simd::Float<N>(1.0f) - t;
   return {a.x * s + b.x * t, a.y * s + b.y * t, a.z * s + b.z * t, a.w * s + b.w * t};
+}
+
+// GL_LINEAR's four texels of each lane in one level per lane (size w x h, first texel `offset`):
+// b0, b1 on the lower row, t0, t1 on the upper one, and the weights' fractions fx, fy.
+template <int N>
+SOFTRAST_SIMD_INLINE void bilinear_texels(const Texture& t, const Sampler& s,
+                                          const simd::Vec2<N>& uv, const simd::Int<N>& w,
+                                          const simd::Int<N>& h, const simd::Int<N>& offset,
+                                          bool pow2_u, bool pow2_v, simd::Int<N>& b0,
+                                          simd::Int<N>& b1, simd::Int<N>& t0, simd::Int<N>& t1,
+                                          simd::Float<N>& fx, simd::Float<N>& fy) {
+  using F = simd::Float<N>;
+  using I = simd::Int<N>;
+  // Texel centres sit at half-integers: shift by half a texel, then split (GL_LINEAR).
+  I x0 = texel_floor<N>(uv.x * simd::to_float(w) - F(0.5f), fx);
+  I y0 = texel_floor<N>(uv.y * simd::to_float(h) - F(0.5f), fy);
+  I one(1);
+  I i0 = wrap_texel<N>(s.wrap_u, x0, w, pow2_u);
+  I i1 = wrap_texel<N>(s.wrap_u, x0 + one, w, pow2_u);
+  I j0 = wrap_texel<N>(s.wrap_v, y0, h, pow2_v);
+  I j1 = wrap_texel<N>(s.wrap_v, y0 + one, h, pow2_v);
+  const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
+  if (simd::bits(i1 == i0 + one) == 0xffffu) {
+    // No lane wraps between its two columns: texels (i0, j) and (i1, j) are neighbours in memory,
+    // so one 64-bit load per lane and row fetches both (the same texels, half the loads).
+    simd::gather_pair<N>(texels, offset + j0 * w + i0, b0, b1);
+    simd::gather_pair<N>(texels, offset + j1 * w + i0, t0, t1);
+    return;
+  }
+  b0 = simd::gather<N>(texels, offset + j0 * w + i0);
+  b1 = simd::gather<N>(texels, offset + j0 * w + i1);
+  t0 = simd::gather<N>(texels, offset + j1 * w + i0);
+  t1 = simd::gather<N>(texels, offset + j1 * w + i1);
 }
 
 // One level per lane (size w x h, first texel `offset`), nearest or bilinear: the arithmetic of
@@ -166,37 +233,11 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_level(const Texture& t, const Sampler&
     I j = wrap_texel<N>(s.wrap_v, texel_floor<N>(uv.y * hf, fy), h, pow2_v);
     return fetch<N>(t, i, j, w, offset, d);
   }
-  // Texel centres sit at half-integers: shift by half a texel, then split (GL_LINEAR).
-  I x0 = texel_floor<N>(uv.x * wf - F(0.5f), fx);
-  I y0 = texel_floor<N>(uv.y * hf - F(0.5f), fy);
-  I one(1);
-  I i0 = wrap_texel<N>(s.wrap_u, x0, w, pow2_u);
-  I i1 = wrap_texel<N>(s.wrap_u, x0 + one, w, pow2_u);
-  I j0 = wrap_texel<N>(s.wrap_v, y0, h, pow2_v);
-  I j1 = wrap_texel<N>(s.wrap_v, y0 + one, h, pow2_v);
-  if (simd::bits(i1 == i0 + one) == 0xffffu) {
-    // No lane wraps between its two columns: texels (i0, j) and (i1, j) are neighbours in memory,
-    // so one 64-bit load per lane and row fetches both (the same texels, half the loads).
-    const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
-    I b0, b1, t0, t1;
-    simd::gather_pair<N>(texels, offset + j0 * w + i0, b0, b1);
-    simd::gather_pair<N>(texels, offset + j1 * w + i0, t0, t1);
-    if (!d) return filter_rgba8<N>(b0, b1, t0, t1, fx, fy);
-    simd::Vec4<N> bottom = lerp<N>(unpack_texel<N>(b0, d), unpack_texel<N>(b1, d), fx);
-    simd::Vec4<N> top = lerp<N>(unpack_texel<N>(t0, d), unpack_texel<N>(t1, d), fx);
-    return lerp<N>(bottom, top, fy);
-  }
-  if (!d) {
-    const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
-    return filter_rgba8<N>(simd::gather<N>(texels, offset + j0 * w + i0),
-                           simd::gather<N>(texels, offset + j0 * w + i1),
-                           simd::gather<N>(texels, offset + j1 * w + i0),
-                           simd::gather<N>(texels, offset + j1 * w + i1), fx, fy);
-  }
-  simd::Vec4<N> bottom =
-      lerp<N>(fetch<N>(t, i0, j0, w, offset, d), fetch<N>(t, i1, j0, w, offset, d), fx);
-  simd::Vec4<N> top =
-      lerp<N>(fetch<N>(t, i0, j1, w, offset, d), fetch<N>(t, i1, j1, w, offset, d), fx);
+  I b0, b1, t0, t1;
+  bilinear_texels<N>(t, s, uv, w, h, offset, pow2_u, pow2_v, b0, b1, t0, t1, fx, fy);
+  if (!d) return filter_rgba8<N>(b0, b1, t0, t1, fx, fy);
+  simd::Vec4<N> bottom = lerp<N>(unpack_texel<N>(b0, d), unpack_texel<N>(b1, d), fx);
+  simd::Vec4<N> top = lerp<N>(unpack_texel<N>(t0, d), unpack_texel<N>(t1, d), fx);
   return lerp<N>(bottom, top, fy);
 }
 
@@ -296,6 +337,7 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_inline(const Texture& texture, const S
 struct SampleLanes {
   alignas(64) float in[6][simd::kLanes];
   alignas(64) float out[4][simd::kLanes];
+  alignas(64) int32_t rgba8[simd::kLanes];  // sample_rgba8's result
 };
 
 // The sampler compiled once per SIMD level (src/texture/sample_kernels.cpp), called from the
@@ -306,6 +348,10 @@ struct SampleLanes {
 void sample_lanes_4(const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives);
 void sample_lanes_8(const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives);
 void sample_lanes_16(const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives);
+// The same without derivatives, packed as RGBA8 into io.rgba8 (sample_rgba8).
+void sample_rgba8_lanes_4(const Texture& texture, const Sampler& s, SampleLanes& io);
+void sample_rgba8_lanes_8(const Texture& texture, const Sampler& s, SampleLanes& io);
+void sample_rgba8_lanes_16(const Texture& texture, const Sampler& s, SampleLanes& io);
 
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_out_of_line(const Texture& texture, const Sampler& s,
@@ -335,6 +381,28 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler&
   uv.x.store(io.in[0]);
   uv.y.store(io.in[1]);
   return detail::sample_out_of_line<N>(texture, s, io, false);
+}
+
+// sample() packed as RGBA8 (red in the low byte): exactly pack_rgba8(sample(...)), lane by lane,
+// for a shader that writes the texel as it is (Fragments::set_rgba8). Bilinear filtering without
+// sRGB decode, the common case, rounds its 16-bit levels straight to bytes instead of going
+// through float and back.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8(const Texture& texture, const Sampler& s,
+                                               const simd::Vec2<N>& uv) {
+  if (texture.empty()) return simd::Int<N>(-1);  // opaque white
+  detail::SampleLanes io;
+  uv.x.store(io.in[0]);
+  uv.y.store(io.in[1]);
+  if constexpr (N == 4) {
+    detail::sample_rgba8_lanes_4(texture, s, io);
+  } else if constexpr (N == 8) {
+    detail::sample_rgba8_lanes_8(texture, s, io);
+  } else {
+    static_assert(N == 16);
+    detail::sample_rgba8_lanes_16(texture, s, io);
+  }
+  return simd::Int<N>::load(io.rgba8);
 }
 
 // The same with the texture coordinates' change to the next pixel right and down (for example
