@@ -41,15 +41,66 @@ typedef int64_t Q __attribute__((vector_size(8 * kD)));
   return __builtin_convertvector(clamp_like_std(fx, -limit, limit), Q);
 }
 
+#if SOFTRAST_DOUBLES == 8
+// A full group's positions: each vertex's x, y, z, w in one load, then two 4x4 transposes (the
+// same floats as the lane-by-lane copy, converted to double exactly).
+[[gnu::always_inline]] inline void load_positions(const float* first, size_t stride, D& x, D& y,
+                                                  D& z, D& w) {
+  __m128 v[8];
+  for (int l = 0; l < 8; ++l) v[l] = _mm_loadu_ps(first + size_t(l) * stride);
+  _MM_TRANSPOSE4_PS(v[0], v[1], v[2], v[3]);
+  _MM_TRANSPOSE4_PS(v[4], v[5], v[6], v[7]);
+  x = reinterpret_cast<D>(_mm512_cvtps_pd(_mm256_set_m128(v[4], v[0])));
+  y = reinterpret_cast<D>(_mm512_cvtps_pd(_mm256_set_m128(v[5], v[1])));
+  z = reinterpret_cast<D>(_mm512_cvtps_pd(_mm256_set_m128(v[6], v[2])));
+  w = reinterpret_cast<D>(_mm512_cvtps_pd(_mm256_set_m128(v[7], v[3])));
+}
+
+// A full group's PackedVertex records, 8 x 24 bytes, as three 64-byte stores: the six fields'
+// lanes paired into (x, y), (z, inv_w), (x_residual, y_residual) 64-bit lanes, then those
+// interleaved record by record.
+[[gnu::always_inline]] inline void store_records(PackedVertex* out, __m256i x, __m256i y, __m256 z,
+                                                 __m256 inv_w, __m256 rx, __m256 ry) {
+  static_assert(sizeof(PackedVertex) == 24);
+  const __m512i pair = _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
+  auto pairs = [&](__m256i lo, __m256i hi) {
+    return _mm512_permutex2var_epi32(_mm512_castsi256_si512(lo), pair, _mm512_castsi256_si512(hi));
+  };
+  const __m512i a = pairs(x, y), b = pairs(_mm256_castps_si256(z), _mm256_castps_si256(inv_w)),
+                c = pairs(_mm256_castps_si256(rx), _mm256_castps_si256(ry));
+  // Record r is a[r] b[r] c[r]; 64-bit lanes of a and b (index 8 + k: b[k]), then c's by mask.
+  auto* dst = reinterpret_cast<__m512i*>(out);
+  _mm512_storeu_si512(
+      dst, _mm512_mask_permutexvar_epi64(
+               _mm512_permutex2var_epi64(a, _mm512_setr_epi64(0, 8, 0, 1, 9, 0, 2, 10), b), 0x24,
+               _mm512_setr_epi64(0, 0, 0, 0, 0, 1, 0, 0), c));
+  _mm512_storeu_si512(
+      dst + 1, _mm512_mask_permutexvar_epi64(
+                   _mm512_permutex2var_epi64(a, _mm512_setr_epi64(0, 3, 11, 0, 4, 12, 0, 5), b),
+                   0x49, _mm512_setr_epi64(2, 0, 0, 3, 0, 0, 4, 0), c));
+  _mm512_storeu_si512(
+      dst + 2, _mm512_mask_permutexvar_epi64(
+                   _mm512_permutex2var_epi64(a, _mm512_setr_epi64(13, 0, 6, 14, 0, 7, 15, 0), b),
+                   0x92, _mm512_setr_epi64(0, 5, 0, 0, 6, 0, 0, 7), c));
+}
+#endif
+
 void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
   const double min_w = double(kMinClipW), width = b.width, height = b.height;
   for (size_t i = begin; i < end; i += kD) {
     size_t lanes = std::min<size_t>(kD, end - i);
     D x, y, z, w;
-    for (int l = 0; l < kD; ++l) {
-      // Past the end, repeat the last vertex (computed, not stored).
-      const float* p = b.data + (i + std::min<size_t>(l, lanes - 1)) * size_t(b.stride);
-      x[l] = p[0], y[l] = p[1], z[l] = p[2], w[l] = p[3];
+#if SOFTRAST_DOUBLES == 8
+    if (lanes == kD) {
+      load_positions(b.data + i * size_t(b.stride), size_t(b.stride), x, y, z, w);
+    } else
+#endif
+    {
+      for (int l = 0; l < kD; ++l) {
+        // Past the end, repeat the last vertex (computed, not stored).
+        const float* p = b.data + (i + std::min<size_t>(l, lanes - 1)) * size_t(b.stride);
+        x[l] = p[0], y[l] = p[1], z[l] = p[2], w[l] = p[3];
+      }
     }
     // clip.cpp: is_finite_position, then clip_outcode's plane_distance(p) >= 0 per plane.
     Q finite = (x - x == 0.0) & (y - y == 0.0) & (z - z == 0.0) & (w - w == 0.0);
@@ -73,6 +124,16 @@ void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
     if (b.depth_bias != 0.0f) {  // geometry_stage.hpp: the depth bias, in float
       for (int l = 0; l < kD; ++l) zf[l] = std::clamp(zf[l] + b.depth_bias, 0.0f, 1.0f);
     }
+#if SOFTRAST_DOUBLES == 8
+    if (lanes == kD) {
+      _mm_storel_epi64(reinterpret_cast<__m128i*>(b.codes + i),
+                       _mm512_cvtepi64_epi8(reinterpret_cast<__m512i>(code)));
+      store_records(b.window + i, reinterpret_cast<__m256i>(xi), reinterpret_cast<__m256i>(yi),
+                    reinterpret_cast<__m256>(zf), reinterpret_cast<__m256>(wf),
+                    reinterpret_cast<__m256>(rxf), reinterpret_cast<__m256>(ryf));
+      continue;
+    }
+#endif
     for (size_t l = 0; l < lanes; ++l) {
       b.codes[i + l] = uint8_t(code[l]);
       b.window[i + l] = {xi[l], yi[l], zf[l], wf[l], rxf[l], ryf[l]};
