@@ -63,9 +63,15 @@ struct FlatShader {
   MeshInputs in;
   glm::vec4 color;
   bool srgb = false;  // encode the output (the linear workflow)
+  // The draw is opaque: the colour is packed once, here, not per block (the same bytes).
+  bool opaque = false;
   glm::vec4 vertex(uint32_t i, float*) const { return in.clip(i); }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
+    if (opaque && !srgb) {
+      f.set_rgba8(simd::Int<N>(int32_t(softrast::pack_rgba8(color))));
+      return;
+    }
     f.color = {color.r, color.g, color.b, color.a};
     if (srgb) f.color = encode_srgb<N>(f.color);
   }

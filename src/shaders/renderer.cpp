@@ -107,10 +107,15 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
   sampler.srgb_decode = opt.srgb;
   switch (kind) {
     case ShaderKind::kFlat:
-      return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, opt.alpha), opt.srgb}, indices,
-                  n);
+      return draw(fb, state,
+                  FlatShader{in, glm::vec4(surf.albedo, opt.alpha), opt.srgb,
+                             state.blend == BlendMode::kOpaque},
+                  indices, n);
     case ShaderKind::kWireframe:  // the overlay passes the wire colour as the surface albedo
-      return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, 1.0f)}, indices, n);
+      return draw(
+          fb, state,
+          FlatShader{in, glm::vec4(surf.albedo, 1.0f), false, state.blend == BlendMode::kOpaque},
+          indices, n);
     case ShaderKind::kGouraud:
       if (two_sided) {
         return draw(fb, state, GouraudShader<true>{in, surf.albedo, lighting, opt.alpha}, indices,
