@@ -297,5 +297,70 @@ TEST(SimdShader, DiscardingWideShaderEqualsItsScalarTwinAtEveryLevel) {
   }
 }
 
+// The same textured quad through a custom wide shader that writes packed bytes
+// (Fragments::set_rgba8 of sample_rgba8) and one that writes f.color = sample(...): opaque, the
+// same image at every level; blended, the packed one blends from byte / 255, as its twin that
+// writes the unpacked bytes as floats does.
+struct TexturedQuad {
+  static constexpr int kVaryings = 2;
+  const Texture* texture;
+  Sampler sampler;
+  bool packed;
+  bool reads_derivatives() const { return false; }
+  glm::vec4 vertex(uint32_t i, float* v) const {
+    static const glm::vec2 kCorners[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    v[0] = kCorners[i].x * 1.7f + 0.3f;  // repeats the texture a few times, magnified
+    v[1] = kCorners[i].y * 1.3f - 0.2f;
+    return {kCorners[i].x * 0.9f, kCorners[i].y * 0.8f, 0.25f * kCorners[i].x, 1.0f};
+  }
+  template <int N>
+  void shade(Fragments<N>& f) const {
+    if (packed) {
+      f.set_rgba8(sample_rgba8<N>(*texture, sampler, f.vec2(0)));
+    } else {
+      f.color = sample<N>(*texture, sampler, f.vec2(0));
+    }
+  }
+};
+struct TexturedQuadUnpacked : TexturedQuad {
+  template <int N>
+  void shade(Fragments<N>& f) const {  // the packed bytes, as floats
+    f.color = detail::unpack_rgba8<N>(sample_rgba8<N>(*texture, sampler, f.vec2(0)));
+  }
+};
+
+TEST(SimdShader, PackedOutputEqualsFloatOutputAtEveryLevel) {
+  SimdLevelGuard guard;
+  Texture texture = noise_texture(64, 32, 11);
+  std::vector<uint32_t> indices = {0, 1, 2, 0, 2, 3};
+  for (Filter filter : {Filter::kNearest, Filter::kBilinear}) {
+    for (BlendMode blend : {BlendMode::kOpaque, BlendMode::kAlpha}) {
+      RenderState state;
+      state.cull = CullMode::kNone;
+      state.blend = blend;
+      Sampler sampler{filter, Wrap::kRepeat, Wrap::kRepeat, false};
+      for (SimdLevel level : levels_of_this_cpu()) {
+        set_simd_level(level);
+        Framebuffer want(131, 77), got(131, 77);
+        want.clear_color({0.2f, 0.4f, 0.6f, 1.0f});
+        got.clear_color({0.2f, 0.4f, 0.6f, 1.0f});
+        if (blend == BlendMode::kOpaque) {
+          draw(want, state, TexturedQuad{&texture, sampler, false}, indices, 4);
+        } else {
+          draw(want, state, TexturedQuadUnpacked{{&texture, sampler, true}}, indices, 4);
+        }
+        draw(got, state, TexturedQuad{&texture, sampler, true}, indices, 4);
+        int differ = 0;
+        for (int y = 0; y < 77; ++y) {
+          for (int x = 0; x < 131; ++x) differ += got.color_at(x, y) != want.color_at(x, y);
+        }
+        EXPECT_EQ(differ, 0) << simd_level_name(level) << " filter " << int(filter) << " blend "
+                             << int(blend);
+        EXPECT_NE(got.color_at(65, 38), got.color_at(0, 0));  // the quad is drawn
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace softrast

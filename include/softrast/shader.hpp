@@ -8,7 +8,8 @@
 //   template <int N> SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const;  // wide: 4x4 at once
 //   bool fragment(FragmentInput& in, glm::vec4& color) const;  // scalar: one pixel, false discards
 // The wide form is written with softrast::simd types (simd.hpp) as if for one pixel: f.vec3(0)
-// is a varying for all 16 pixels, f.color the output; it is compiled for SSE2, SSE4, AVX2 and
+// is a varying for all 16 pixels, f.color the output (or f.set_rgba8(packed) for a result that
+// comes as bytes, such as softrast::sample_rgba8's); it is compiled for SSE2, SSE4, AVX2 and
 // AVX-512 and the widest the CPU has runs. Declare it SOFTRAST_SIMD_INLINE (always inline): GCC
 // can otherwise compile it once, for the baseline x86-64, and call that copy from every level's
 // block function (its wide operations then run as SSE2 code that calls out for every operation,
