@@ -95,13 +95,13 @@ SOFTRAST_SIMD_INLINE simd::Int<N> filter_weight(const simd::Float<N>& f) {
 
 // GL_LINEAR of four RGBA8 texels per lane (b0, b1: the lower row, t0, t1: the upper one),
 // Texture::filter_rgba8's integers: the channels in the 16-bit halves of each lane (red and blue
-// in `rb`, green and alpha in `ga`), each a level with 7 fraction bits (0 to 255 * 128), blended
-// by simd::isa::mul_round15 (PMULHRSW).
+// in `red_blue`, green and alpha in `green_alpha`), each a level with 7 fraction bits (0 to
+// 255 * 128), blended by simd::isa::mul_round15 (PMULHRSW).
 template <int N>
 SOFTRAST_SIMD_INLINE void filter_levels(const simd::Int<N>& b0, const simd::Int<N>& b1,
                                         const simd::Int<N>& t0, const simd::Int<N>& t1,
                                         const simd::Float<N>& fx, const simd::Float<N>& fy,
-                                        simd::Int<N>& rb, simd::Int<N>& ga) {
+                                        simd::Int<N>& red_blue, simd::Int<N>& green_alpha) {
   using I = simd::Int<N>;
   using V = typename simd::Native<N>::I;
   typedef int16_t H __attribute__((vector_size(sizeof(V))));
@@ -112,15 +112,15 @@ SOFTRAST_SIMD_INLINE void filter_levels(const simd::Int<N>& b0, const simd::Int<
     for (int half = 0; half < 2; ++half) {  // red and blue, then green and alpha
       const int s = 8 * half;
       // Levels with 7 fraction bits: at most 255 * 128 = 32640, so differences fit in int16.
-      H lb = H(((b0.p[k] >> s) & even) << 7), rb_ = H(((b1.p[k] >> s) & even) << 7);
+      H lb = H(((b0.p[k] >> s) & even) << 7), rb = H(((b1.p[k] >> s) & even) << 7);
       H lt = H(((t0.p[k] >> s) & even) << 7), rt = H(((t1.p[k] >> s) & even) << 7);
       V d;
-      simd::isa::mul_round15(V(rb_ - lb), x, d);
+      simd::isa::mul_round15(V(rb - lb), x, d);
       H bottom = lb + H(d);
       simd::isa::mul_round15(V(rt - lt), x, d);
       H top = lt + H(d);
       simd::isa::mul_round15(V(top - bottom), y, d);
-      (half == 0 ? rb : ga).p[k] = V(bottom + H(d));
+      (half == 0 ? red_blue : green_alpha).p[k] = V(bottom + H(d));
     }
   }
 }
@@ -134,12 +134,12 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> filter_rgba8(const simd::Int<N>& b0, const si
   using I = simd::Int<N>;
   using V = typename simd::Native<N>::I;
   using Fn = typename simd::Native<N>::F;
-  I rb, ga;
-  filter_levels<N>(b0, b1, t0, t1, fx, fy, rb, ga);
+  I red_blue, green_alpha;
+  filter_levels<N>(b0, b1, t0, t1, fx, fy, red_blue, green_alpha);
   simd::Vec4<N> out;
   for (int k = 0; k < I::kParts; ++k) {
     for (int half = 0; half < 2; ++half) {
-      const V v = (half == 0 ? rb : ga).p[k];
+      const V v = (half == 0 ? red_blue : green_alpha).p[k];
       // v / 128 is exact, and then the same multiplication as Texture::texel's.
       const Fn to_level = Fn{} + 1.0f / 128.0f, k255 = Fn{} + 1.0f / 255.0f;
       Fn low = (__builtin_convertvector(v & 0xffff, Fn) * to_level) * k255;
@@ -161,10 +161,10 @@ SOFTRAST_SIMD_INLINE simd::Int<N> filter_rgba8_packed(
     const simd::Int<N>& b0, const simd::Int<N>& b1, const simd::Int<N>& t0, const simd::Int<N>& t1,
     const simd::Float<N>& fx, const simd::Float<N>& fy) {
   using I = simd::Int<N>;
-  I rb, ga;
-  filter_levels<N>(b0, b1, t0, t1, fx, fy, rb, ga);
+  I red_blue, green_alpha;
+  filter_levels<N>(b0, b1, t0, t1, fx, fy, red_blue, green_alpha);
   const I round(0x00400040), bytes(0x00ff00ff);
-  return (((rb + round) >> 7) & bytes) | ((((ga + round) >> 7) & bytes) << 8);
+  return (((red_blue + round) >> 7) & bytes) | ((((green_alpha + round) >> 7) & bytes) << 8);
 }
 
 // Texel (i, j) of the level whose size and first texel are (w, h, offset), lane by lane.
