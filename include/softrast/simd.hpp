@@ -319,6 +319,13 @@ SOFTRAST_SIMD_INLINE Float<N> bit_cast_float(const Int<N>& a) {
   for (int k = 0; k < Float<N>::kParts; ++k) r.p[k] = typename Native<N>::F(a.p[k]);
   return r;
 }
+// The smaller of two 32-bit integers, lane by lane.
+template <int N>
+SOFTRAST_SIMD_INLINE Int<N> min(const Int<N>& a, const Int<N>& b) {
+  Int<N> r;
+  for (int k = 0; k < Int<N>::kParts; ++k) r.p[k] = a.p[k] < b.p[k] ? a.p[k] : b.p[k];
+  return r;
+}
 template <int N>
 SOFTRAST_SIMD_INLINE Float<N> abs(const Float<N>& a) {
   return bit_cast_float(bit_cast_int(a) & Int<N>(0x7fffffff));

@@ -272,7 +272,9 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   // keeps derivatives finite (clamping 1/w to a tiny positive value made them huge and sent
   // trilinear lookups to the last mip level). Only a 1/w too close to 0 to divide by is moved.
   F inv_w = eval_plane<N>(in.inv_w, dx, dy);
-  inv_w = simd::select((inv_w < F(1.0e-30f)) & (inv_w > F(-1.0e-30f)), F(1.0e-30f), inv_w);
+  // |inv_w| < 1e-30 is the scalar test's -1e-30 < inv_w < 1e-30 (NaN fails both), in one
+  // comparison.
+  inv_w = simd::select(simd::abs(inv_w) < F(1.0e-30f), F(1.0e-30f), inv_w);
   F w = F(1.0f) / inv_w;
   F var[kN];
   for (int i = 0; i < S::kVaryings; ++i) var[i] = eval_plane<N>(in.var[i], dx, dy) * w;
@@ -380,7 +382,9 @@ SOFTRAST_SIMD_INLINE void shade_mixed_wide(const S& shader, const ShadeTarget& t
   f.depth = z;
   // eval_plane's operations, with per-lane coefficients.
   F inv_w = a0 + dadx * dx + dady * dy;
-  inv_w = simd::select((inv_w < F(1.0e-30f)) & (inv_w > F(-1.0e-30f)), F(1.0e-30f), inv_w);
+  // |inv_w| < 1e-30 is the scalar test's -1e-30 < inv_w < 1e-30 (NaN fails both), in one
+  // comparison.
+  inv_w = simd::select(simd::abs(inv_w) < F(1.0e-30f), F(1.0e-30f), inv_w);
   F w = F(1.0f) / inv_w;
   F var[kN];
   for (int i = 0; i < S::kVaryings; ++i) {

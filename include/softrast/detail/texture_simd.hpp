@@ -90,7 +90,7 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> unpack_texel(const simd::Int<N>& texel, bool 
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Int<N> filter_weight(const simd::Float<N>& f) {
   simd::Int<N> w = simd::to_int(f * simd::Float<N>(32768.0f) + simd::Float<N>(0.5f));
-  return simd::select(w > simd::Int<N>(32767), simd::Int<N>(32767), w);
+  return simd::min(w, simd::Int<N>(32767));
 }
 
 // GL_LINEAR of four RGBA8 texels per lane (b0, b1: the lower row, t0, t1: the upper one),
@@ -108,12 +108,15 @@ SOFTRAST_SIMD_INLINE void filter_levels(const simd::Int<N>& b0, const simd::Int<
   const I wx = filter_weight<N>(fx), wy = filter_weight<N>(fy);
   for (int k = 0; k < I::kParts; ++k) {
     const V x = wx.p[k] | (wx.p[k] << 16), y = wy.p[k] | (wy.p[k] << 16);  // in both halves
-    const V even = V{} + 0x00ff00ff;
+    // A texel's even bytes (half 0) or odd bytes (half 1) as levels, in the 16-bit halves:
+    // (t >> 8 * half) & 0x00ff00ff, times 128 (the odd bytes in two operations: t >> 1, masked).
+    auto level = [](const V& t, int half) {
+      return H(half == 0 ? (t & 0x00ff00ff) << 7 : (t >> 1) & 0x7f807f80);
+    };
     for (int half = 0; half < 2; ++half) {  // red and blue, then green and alpha
-      const int s = 8 * half;
       // Levels with 7 fraction bits: at most 255 * 128 = 32640, so differences fit in int16.
-      H lb = H(((b0.p[k] >> s) & even) << 7), rb = H(((b1.p[k] >> s) & even) << 7);
-      H lt = H(((t0.p[k] >> s) & even) << 7), rt = H(((t1.p[k] >> s) & even) << 7);
+      H lb = level(b0.p[k], half), rb = level(b1.p[k], half);
+      H lt = level(t0.p[k], half), rt = level(t1.p[k], half);
       V d;
       simd::isa::mul_round15(V(rb - lb), x, d);
       H bottom = lb + H(d);
