@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "shaders/builtin_shaders.hpp"
 #include "softrast/renderer.hpp"
 #include "softrast/shader.hpp"
 
@@ -358,6 +359,53 @@ TEST(SimdShader, PackedOutputEqualsFloatOutputAtEveryLevel) {
                              << int(blend);
         EXPECT_NE(got.color_at(65, 38), got.color_at(0, 0));  // the quad is drawn
       }
+    }
+  }
+}
+
+// The built-in texture shader writes packed bytes only where the draw is opaque (f.opaque):
+// against a twin that always writes f.color = sample(...), the same image opaque and alpha
+// blended (the texture's own alpha blends), at every level.
+struct FloatTextureTwin {
+  static constexpr int kVaryings = 2;
+  detail::TextureShader shader;
+  bool reads_derivatives() const { return false; }
+  glm::vec4 vertex(uint32_t i, float* v) const { return shader.vertex(i, v); }
+  template <int N>
+  void shade(Fragments<N>& f) const {
+    f.color = sample<N>(*shader.texture, shader.sampler, f.vec2(0));
+  }
+};
+
+TEST(SimdShader, BuiltInTextureShaderWritesBytesOnlyWhenOpaque) {
+  SimdLevelGuard guard;
+  Texture texture = noise_texture(64, 32, 5);
+  Mesh quad;
+  quad.positions = {
+      {-0.9f, -0.8f, 0.1f}, {0.9f, -0.8f, -0.1f}, {0.9f, 0.8f, 0.2f}, {-0.9f, 0.8f, 0.0f}};
+  quad.uvs = {{-0.4f, -0.7f}, {2.1f, -0.7f}, {2.1f, 1.6f}, {-0.4f, 1.6f}};
+  std::vector<uint32_t> indices = {0, 1, 2, 0, 2, 3};
+  detail::TextureShader shader;
+  shader.in.mesh = &quad;
+  shader.texture = &texture;
+  shader.sampler = {Filter::kBilinear, Wrap::kRepeat, Wrap::kRepeat, false};
+  for (BlendMode blend : {BlendMode::kOpaque, BlendMode::kAlpha}) {
+    RenderState state;
+    state.cull = CullMode::kNone;
+    state.blend = blend;
+    for (SimdLevel level : levels_of_this_cpu()) {
+      set_simd_level(level);
+      Framebuffer want(131, 77), got(131, 77);
+      want.clear_color({0.2f, 0.4f, 0.6f, 1.0f});
+      got.clear_color({0.2f, 0.4f, 0.6f, 1.0f});
+      draw(want, state, FloatTextureTwin{shader}, indices, 4);
+      draw(got, state, shader, indices, 4);
+      int differ = 0;
+      for (int y = 0; y < 77; ++y) {
+        for (int x = 0; x < 131; ++x) differ += got.color_at(x, y) != want.color_at(x, y);
+      }
+      EXPECT_EQ(differ, 0) << simd_level_name(level) << " blend " << int(blend);
+      EXPECT_NE(got.color_at(65, 38), got.color_at(0, 0));  // the quad is drawn
     }
   }
 }

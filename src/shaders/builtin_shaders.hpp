@@ -63,12 +63,11 @@ struct FlatShader {
   MeshInputs in;
   glm::vec4 color;
   bool srgb = false;  // encode the output (the linear workflow)
-  // The draw is opaque: the colour is packed once, here, not per block (the same bytes).
-  bool opaque = false;
   glm::vec4 vertex(uint32_t i, float*) const { return in.clip(i); }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
-    if (opaque && !srgb) {
+    if (f.opaque && !srgb) {  // one scalar pack instead of the fragment stage's 16-lane one
+
       f.set_rgba8(simd::Int<N>(int32_t(softrast::pack_rgba8(color))));
       return;
     }
@@ -118,9 +117,6 @@ struct TextureShader {
   Sampler sampler;
   float alpha = 1.0f;
   bool srgb = false;  // encode the output (the linear workflow)
-  // The draw is opaque: the texel is written as it is, packed by the sampler (sample_rgba8: the
-  // same bytes), where alpha is 1, nothing is encoded and no mip levels are read.
-  bool opaque = false;
   bool reads_derivatives() const { return sampler.filter == Filter::kTrilinear; }
   glm::vec4 vertex(uint32_t i, float* v) const {
     v[0] = in.mesh->uvs[i].x, v[1] = in.mesh->uvs[i].y;
@@ -128,7 +124,9 @@ struct TextureShader {
   }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
-    if (opaque && alpha == 1.0f && !srgb && sampler.filter != Filter::kTrilinear) {
+    // Opaque, alpha 1, nothing encoded, no mip levels: the texel as it is, packed by the sampler
+    // (sample_rgba8: the same bytes).
+    if (f.opaque && alpha == 1.0f && !srgb && sampler.filter != Filter::kTrilinear) {
       f.set_rgba8(sample_rgba8<N>(*texture, sampler, f.vec2(0)));
       return;
     }

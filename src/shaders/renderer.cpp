@@ -107,15 +107,10 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
   sampler.srgb_decode = opt.srgb;
   switch (kind) {
     case ShaderKind::kFlat:
-      return draw(fb, state,
-                  FlatShader{in, glm::vec4(surf.albedo, opt.alpha), opt.srgb,
-                             state.blend == BlendMode::kOpaque},
-                  indices, n);
+      return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, opt.alpha), opt.srgb}, indices,
+                  n);
     case ShaderKind::kWireframe:  // the overlay passes the wire colour as the surface albedo
-      return draw(
-          fb, state,
-          FlatShader{in, glm::vec4(surf.albedo, 1.0f), false, state.blend == BlendMode::kOpaque},
-          indices, n);
+      return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, 1.0f)}, indices, n);
     case ShaderKind::kGouraud:
       if (two_sided) {
         return draw(fb, state, GouraudShader<true>{in, surf.albedo, lighting, opt.alpha}, indices,
@@ -125,9 +120,7 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
                   n);
     case ShaderKind::kTexture: {
       const Texture* t = surf.texture ? surf.texture : &kWhite;
-      TextureShader shader{in, t, sampler, opt.alpha, opt.srgb};
-      shader.opaque = state.blend == BlendMode::kOpaque;
-      return draw(fb, state, shader, indices, n);
+      return draw(fb, state, TextureShader{in, t, sampler, opt.alpha, opt.srgb}, indices, n);
     }
     case ShaderKind::kPhong:
     case ShaderKind::kPbr: {  // pbr is drawn by render_pbr; phong if it ever gets here

@@ -41,6 +41,9 @@ struct Fragments {
   F depth;                   // window depth in [0, 1]; a shader with kWritesDepth may set it
   simd::Int<N> live;         // lanes still to be written: covered and not discarded
   bool front_facing = true;  // the primitive's facing
+  // The colour replaces what is stored (no blending): a shader may then write bytes that are
+  // exactly what the fragment stage would make of its float colour (set_rgba8).
+  bool opaque = true;
   // The pixels belong to several triangles (a shader whose reads_derivatives() is false): no
   // derivatives then; ddx and ddy stop the program.
   bool several_triangles = false;
@@ -253,6 +256,7 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   F dx = f.x - F(in.x_ref), dy = f.y - F(in.y_ref);
   F z = simd::clamp(eval_plane<N>(in.z, dx, dy), F(0.0f), F(1.0f));
   f.live = simd::lanes_of<N>(mask);
+  f.opaque = blend_mode == BlendMode::kOpaque;
 
   // The framebuffer stores a block's 16 pixels together (framebuffer.hpp): one aligned vector
   // load or store each for depth and colour. Blocks cut by the image's edge exist whole, and

@@ -93,6 +93,17 @@ SOFTRAST_SIMD_INLINE simd::Int<N> filter_weight(const simd::Float<N>& f) {
   return simd::min(w, simd::Int<N>(32767));
 }
 
+// A texel's even bytes (half 0) or odd bytes (half 1) as levels in the 16-bit halves of its lane:
+// (t >> 8 * half) & 0x00ff00ff, times 128 (the odd bytes in two operations: t >> 1, masked). A
+// named always-inline function, not a lambda, which would be compiled for the baseline with its
+// vectors in another ABI (see shade_simd.hpp's pack_channel).
+// (The result by reference: a vector returned by value draws GCC's -Wpsabi note in the baseline
+// translation units.)
+template <class V>
+SOFTRAST_SIMD_INLINE void texel_levels(const V& t, int half, V& out) {
+  out = half == 0 ? (t & 0x00ff00ff) << 7 : (t >> 1) & 0x7f807f80;
+}
+
 // GL_LINEAR of four RGBA8 texels per lane (b0, b1: the lower row, t0, t1: the upper one),
 // Texture::filter_rgba8's integers: the channels in the 16-bit halves of each lane (red and blue
 // in `red_blue`, green and alpha in `green_alpha`), each a level with 7 fraction bits (0 to
@@ -108,15 +119,14 @@ SOFTRAST_SIMD_INLINE void filter_levels(const simd::Int<N>& b0, const simd::Int<
   const I wx = filter_weight<N>(fx), wy = filter_weight<N>(fy);
   for (int k = 0; k < I::kParts; ++k) {
     const V x = wx.p[k] | (wx.p[k] << 16), y = wy.p[k] | (wy.p[k] << 16);  // in both halves
-    // A texel's even bytes (half 0) or odd bytes (half 1) as levels, in the 16-bit halves:
-    // (t >> 8 * half) & 0x00ff00ff, times 128 (the odd bytes in two operations: t >> 1, masked).
-    auto level = [](const V& t, int half) {
-      return H(half == 0 ? (t & 0x00ff00ff) << 7 : (t >> 1) & 0x7f807f80);
-    };
     for (int half = 0; half < 2; ++half) {  // red and blue, then green and alpha
       // Levels with 7 fraction bits: at most 255 * 128 = 32640, so differences fit in int16.
-      H lb = level(b0.p[k], half), rb = level(b1.p[k], half);
-      H lt = level(t0.p[k], half), rt = level(t1.p[k], half);
+      V levels[4];
+      texel_levels(b0.p[k], half, levels[0]);
+      texel_levels(b1.p[k], half, levels[1]);
+      texel_levels(t0.p[k], half, levels[2]);
+      texel_levels(t1.p[k], half, levels[3]);
+      H lb = H(levels[0]), rb = H(levels[1]), lt = H(levels[2]), rt = H(levels[3]);
       V d;
       simd::isa::mul_round15(V(rb - lb), x, d);
       H bottom = lb + H(d);
