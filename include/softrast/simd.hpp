@@ -531,12 +531,14 @@ inline void gather_pair(const int32_t* base, const Native<4>::I& index, Native<4
 }
 [[gnu::target("avx512f")]] inline void gather_pair(const int32_t* base, const Native<16>::I& index,
                                                    Native<16>::I& lo, Native<16>::I& hi) {
-  __m512i i = __m512i(index);
-  // The masked form with a zero source: the same loads, and GCC 12's header does not leave the
-  // unmasked form's source uninitialised (a -Wmaybe-uninitialized warning per use).
+  // The masked form with a zero source, and the index's halves by a vector shuffle: the same
+  // instructions, and GCC 12's header does not leave the unmasked forms' sources uninitialised (a
+  // -Wmaybe-uninitialized warning wherever this is inlined; GCC bug 105593).
   const __m512i zero = _mm512_setzero_si512();
-  __m512i a = _mm512_mask_i32gather_epi64(zero, 0xff, _mm512_castsi512_si256(i), base, 4);
-  __m512i c = _mm512_mask_i32gather_epi64(zero, 0xff, _mm512_extracti64x4_epi64(i, 1), base, 4);
+  const Native<8>::I low = __builtin_shufflevector(index, index, 0, 1, 2, 3, 4, 5, 6, 7);
+  const Native<8>::I high = __builtin_shufflevector(index, index, 8, 9, 10, 11, 12, 13, 14, 15);
+  __m512i a = _mm512_mask_i32gather_epi64(zero, 0xff, __m256i(low), base, 4);
+  __m512i c = _mm512_mask_i32gather_epi64(zero, 0xff, __m256i(high), base, 4);
   const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
   const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
   lo = Native<16>::I(_mm512_permutex2var_epi32(a, even, c));

@@ -89,17 +89,6 @@ struct Texels16 {
   __m512 r, g, b, a;
 };
 
-// texel_floor: floor(x) and x - floor(x); NaN and |x| >= 1e9 give texel 0, fraction 0. (The
-// fraction of -0 comes out +0 here and -0 there; both give the weight 0.)
-SOFTRAST_AVX512_FN __m512i floor16(__m512 x, __m512& fraction) {
-  __mmask16 ok = _mm512_cmp_ps_mask(x, _mm512_set1_ps(-1.0e9f), _CMP_GT_OQ) &
-                 _mm512_cmp_ps_mask(x, _mm512_set1_ps(1.0e9f), _CMP_LT_OQ);
-  __m512 xs = _mm512_maskz_mov_ps(ok, x);
-  __m512 whole = _mm512_roundscale_ps(xs, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
-  fraction = _mm512_sub_ps(xs, whole);
-  return _mm512_cvttps_epi32(whole);
-}
-
 // wrap_texel (texture_simd.hpp) on native vectors: sizes per lane, every mode.
 SOFTRAST_AVX512_FN __m512i wrap16(Wrap mode, __m512i i, __m512i size, bool pow2) {
   simd::Int<16> index, sizes;
@@ -136,10 +125,10 @@ SOFTRAST_AVX512_FN void bilinear16_texels(const Texture& t, const Sampler& s, __
                                           __m512i w, __m512i h, __m512i offset, bool pow2_u,
                                           bool pow2_v, int row_shift, __m512i& b0, __m512i& b1,
                                           __m512i& t0, __m512i& t1, __m512& fx, __m512& fy) {
-  __m512i x0 =
-      floor16(_mm512_sub_ps(_mm512_mul_ps(u, _mm512_cvtepi32_ps(w)), _mm512_set1_ps(0.5f)), fx);
-  __m512i y0 =
-      floor16(_mm512_sub_ps(_mm512_mul_ps(v, _mm512_cvtepi32_ps(h)), _mm512_set1_ps(0.5f)), fy);
+  __m512i x0 = avx512::floor16(
+      _mm512_sub_ps(_mm512_mul_ps(u, _mm512_cvtepi32_ps(w)), _mm512_set1_ps(0.5f)), fx);
+  __m512i y0 = avx512::floor16(
+      _mm512_sub_ps(_mm512_mul_ps(v, _mm512_cvtepi32_ps(h)), _mm512_set1_ps(0.5f)), fy);
   const __m512i one = _mm512_set1_epi32(1);
   __m512i i0 = wrap16(s.wrap_u, x0, w, pow2_u);
   __m512i i1 = wrap16(s.wrap_u, _mm512_add_epi32(x0, one), w, pow2_u);

@@ -180,6 +180,120 @@ SOFTRAST_SIMD_INLINE simd::Int<N> filter_rgba8_packed(
   return (((red_blue + round) >> 7) & bytes) | ((((green_alpha + round) >> 7) & bytes) << 8);
 }
 
+// The common bilinear sample at AVX-512, inlined into the 16-lane shaders: the base level of an
+// RGBA8 texture without sRGB decode, each axis clamped to the edge or repeated over a power-of-two
+// size. The arithmetic is sample_level's, the same operations in the same order (so the same
+// bits); the way there is shorter: the floor instruction in place of texel_floor's truncate,
+// compare and correct, a mask or a clamp in place of the generic wrap, comparisons straight into
+// mask registers. Inlined, a sample saves the call's spills of the shader's live vectors and
+// the lanes' round trip through memory (SampleLanes); the other cases stay out of line.
+namespace avx512 {
+
+#define SOFTRAST_AVX512_SAMPLER [[gnu::target("avx512f,avx512bw,avx512dq,avx512vl")]] inline
+
+// Whether bilinear_texels16 below takes `texture` sampled through `s`.
+inline bool bilinear_rgba8_applies(const Texture& texture, const Sampler& s) {
+  const int w = texture.width(), h = texture.height();
+  const bool u_ok =
+      s.wrap_u == Wrap::kClampToEdge || (s.wrap_u == Wrap::kRepeat && (w & (w - 1)) == 0);
+  const bool v_ok =
+      s.wrap_v == Wrap::kClampToEdge || (s.wrap_v == Wrap::kRepeat && (h & (h - 1)) == 0);
+  return s.filter == Filter::kBilinear && !texture.decodes(s) && u_ok && v_ok && !texture.empty();
+}
+
+// texel_floor: floor(x) and x - floor(x); NaN and |x| >= 1e9 give texel 0, fraction 0. (The
+// fraction of -0 comes out +0 here and -0 there; both give the weight 0.) Here and below, the
+// masked forms of the intrinsics and GCC's vector operators: the unmasked intrinsics of GCC 12's
+// header leave a variable uninitialised, which -Wmaybe-uninitialized reports at every inlining
+// site (GCC bug 105593, fixed in GCC 13).
+SOFTRAST_AVX512_SAMPLER __m512i floor16(__m512 x, __m512& fraction) {
+  __mmask16 ok = _mm512_cmp_ps_mask(x, _mm512_set1_ps(-1.0e9f), _CMP_GT_OQ) &
+                 _mm512_cmp_ps_mask(x, _mm512_set1_ps(1.0e9f), _CMP_LT_OQ);
+  __m512 xs = _mm512_maskz_mov_ps(ok, x);
+  __m512 whole =
+      _mm512_maskz_roundscale_ps(__mmask16(0xffff), xs, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+  fraction = _mm512_sub_ps(xs, whole);
+  return __m512i(__builtin_convertvector(simd::Native<16>::F(whole), simd::Native<16>::I));
+}
+
+// wrap_texel for the two modes bilinear_texels16 takes (`last`: the size minus one, a power of
+// two minus one when repeating).
+SOFTRAST_AVX512_SAMPLER __m512i wrap_clamp_or_repeat16(Wrap mode, __m512i i, int last) {
+  using V = simd::Native<16>::I;
+  V x = V(i);
+  if (mode == Wrap::kClampToEdge) {
+    x = x < 0 ? V{} : x;
+    return __m512i(x > last ? V{} + last : x);
+  }
+  return __m512i(x & last);
+}
+
+// The four texels (bilinear_texels) and the weights' fractions of 16 lanes where
+// bilinear_rgba8_applies.
+SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const Texture& t, const Sampler& s, __m512 u,
+                                               __m512 v, simd::Int<16>& b0, simd::Int<16>& b1,
+                                               simd::Int<16>& t0, simd::Int<16>& t1,
+                                               simd::Float<16>& fxl, simd::Float<16>& fyl) {
+  using V = simd::Native<16>::I;
+  const int w = t.width(), h = t.height();
+  __m512 fx, fy;
+  __m512i x0 =
+      floor16(_mm512_sub_ps(_mm512_mul_ps(u, _mm512_set1_ps(float(w))), _mm512_set1_ps(0.5f)), fx);
+  __m512i y0 =
+      floor16(_mm512_sub_ps(_mm512_mul_ps(v, _mm512_set1_ps(float(h))), _mm512_set1_ps(0.5f)), fy);
+  const __m512i one = _mm512_set1_epi32(1);
+  V i0 = V(wrap_clamp_or_repeat16(s.wrap_u, x0, w - 1));
+  V i1 = V(wrap_clamp_or_repeat16(s.wrap_u, _mm512_add_epi32(x0, one), w - 1));
+  V j0 = V(wrap_clamp_or_repeat16(s.wrap_v, y0, h - 1));
+  V j1 = V(wrap_clamp_or_repeat16(s.wrap_v, _mm512_add_epi32(y0, one), h - 1));
+  V row0, row1;
+  if ((w & (w - 1)) == 0) {
+    const int shift = __builtin_ctz(unsigned(w));
+    row0 = j0 << shift;
+    row1 = j1 << shift;
+  } else {
+    row0 = j0 * w;
+    row1 = j1 * w;
+  }
+  const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
+  if (_mm512_cmpneq_epi32_mask(__m512i(i1), __m512i(i0 + 1)) == 0) {
+    // No lane wraps between its columns: one 64-bit load per lane and row (sample_level).
+    simd::isa::gather_pair(texels, row0 + i0, b0.p[0], b1.p[0]);
+    simd::isa::gather_pair(texels, row1 + i0, t0.p[0], t1.p[0]);
+  } else {
+    const __m512i zero = _mm512_setzero_si512();
+    const __mmask16 all = 0xffff;
+    b0.p[0] = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row0 + i0), texels, 4));
+    b1.p[0] = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row0 + i1), texels, 4));
+    t0.p[0] = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row1 + i0), texels, 4));
+    t1.p[0] = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row1 + i1), texels, 4));
+  }
+  fxl.p[0] = simd::Native<16>::F(fx);
+  fyl.p[0] = simd::Native<16>::F(fy);
+}
+
+// sample_rgba8 and sample (below) of 16 lanes where bilinear_rgba8_applies. Arguments and
+// results by reference: a caller compiled for the baseline (a test, say) that does not inline
+// these passes 64-byte vectors in memory where they expect registers.
+SOFTRAST_AVX512_SAMPLER void bilinear_rgba8_packed(const Texture& t, const Sampler& s,
+                                                   const simd::Vec2<16>& uv, simd::Int<16>& out) {
+  simd::Int<16> b0, b1, t0, t1;
+  simd::Float<16> fx, fy;
+  bilinear_texels16(t, s, __m512(uv.x.p[0]), __m512(uv.y.p[0]), b0, b1, t0, t1, fx, fy);
+  out = filter_rgba8_packed<16>(b0, b1, t0, t1, fx, fy);
+}
+SOFTRAST_AVX512_SAMPLER void bilinear_rgba8_float(const Texture& t, const Sampler& s,
+                                                  const simd::Vec2<16>& uv, simd::Vec4<16>& out) {
+  simd::Int<16> b0, b1, t0, t1;
+  simd::Float<16> fx, fy;
+  bilinear_texels16(t, s, __m512(uv.x.p[0]), __m512(uv.y.p[0]), b0, b1, t0, t1, fx, fy);
+  out = filter_rgba8<16>(b0, b1, t0, t1, fx, fy);
+}
+
+#undef SOFTRAST_AVX512_SAMPLER
+
+}  // namespace avx512
+
 // Texel (i, j) of the level whose size and first texel are (w, h, offset), lane by lane.
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> fetch(const Texture& t, const simd::Int<N>& i,
@@ -357,7 +471,10 @@ struct SampleLanes {
 // shaders: inlined into every sampling site of every shader, it made most of their code (a
 // phong or pbr block function ran to a megabyte at SSE2) for no speed, since a call per 16
 // pixels costs little next to the gathers. N = 4 is the baseline's (SSE4.2 shaders call it
-// too), 8 needs AVX2 and 16 AVX-512, which is what the shader's level has.
+// too), 8 needs AVX2 and 16 AVX-512, which is what the shader's level has. (The one exception is
+// avx512::bilinear_texels16 above, the common case at the widest level, inlined: without the
+// call's spills and the lanes' trip through memory, quad_grid texture and phong ran 4 and 6 %
+// faster.)
 void sample_lanes_4(const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives);
 void sample_lanes_8(const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives);
 void sample_lanes_16(const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives);
@@ -390,6 +507,13 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler&
                                           const simd::Vec2<N>& uv) {
   using F = simd::Float<N>;
   if (texture.empty()) return {F(1.0f), F(1.0f), F(1.0f), F(1.0f)};
+  if constexpr (N == 16) {
+    if (detail::avx512::bilinear_rgba8_applies(texture, s)) {
+      simd::Vec4<N> c;
+      detail::avx512::bilinear_rgba8_float(texture, s, uv, c);
+      return c;
+    }
+  }
   detail::SampleLanes io;
   uv.x.store(io.in[0]);
   uv.y.store(io.in[1]);
@@ -404,6 +528,13 @@ template <int N>
 SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8(const Texture& texture, const Sampler& s,
                                                const simd::Vec2<N>& uv) {
   if (texture.empty()) return simd::Int<N>(-1);  // opaque white
+  if constexpr (N == 16) {
+    if (detail::avx512::bilinear_rgba8_applies(texture, s)) {
+      simd::Int<N> packed;
+      detail::avx512::bilinear_rgba8_packed(texture, s, uv, packed);
+      return packed;
+    }
+  }
   detail::SampleLanes io;
   uv.x.store(io.in[0]);
   uv.y.store(io.in[1]);
