@@ -115,17 +115,66 @@ SOFTRAST_SIMD_INLINE simd::Float<N> eval_plane(const Plane& p, const simd::Float
   // The scalar eval_plane's operation order, so that both give the same bits.
   return simd::Float<N>(p.a0) + simd::Float<N>(p.dadx) * dx + simd::Float<N>(p.dady) * dy;
 }
+// Half a register's floats, and as many doubles (one register), at SSE and AVX2.
+template <std::size_t kBytes>
+struct HalfLanes;
+template <>
+struct HalfLanes<16> {
+  typedef float F __attribute__((vector_size(8)));
+  typedef double D __attribute__((vector_size(16)));
+};
+template <>
+struct HalfLanes<32> {
+  typedef float F __attribute__((vector_size(16)));
+  typedef double D __attribute__((vector_size(32)));
+};
+// (A named function, not a lambda: see pack_channel.)
+template <class H, class DH>
+SOFTRAST_SIMD_INLINE void half_plane(const DepthPlane& p, const H& x, const H& y, H& out) {
+  const DH xd = __builtin_convertvector(x, DH), yd = __builtin_convertvector(y, DH);
+  out = __builtin_convertvector(((DH{} + p.a0) + (DH{} + p.dadx) * xd) + (DH{} + p.dady) * yd, H);
+}
 // Depth: the plane in double, rounded to float once, as the scalar eval_plane and the tile
-// kernels' depth resolve compute it (the same operations, so the same bits).
+// kernels' depth resolve compute it (the same operations, so the same bits). At SSE and AVX2 each
+// part's lanes go in two halves, each converted to one register of doubles: a vector of doubles
+// twice the register's width, broadcast from a scalar, went through the stack lane by lane there
+// (scalar stores, then wide loads that could not take them from the store buffer: a third of the
+// AVX2 texture shader's samples).
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Float<N> eval_plane(const DepthPlane& p, const simd::Float<N>& dx,
                                                const simd::Float<N>& dy) {
-  using D = typename simd::Native<N>::D;
-  D a0 = D{} + p.a0, dadx = D{} + p.dadx, dady = D{} + p.dady;
+  using Fn = typename simd::Native<N>::F;
+  constexpr int kHalf = int(sizeof(Fn) / sizeof(float)) / 2;
   simd::Float<N> z;
-  for (int k = 0; k < simd::Float<N>::kParts; ++k) {
-    D x = __builtin_convertvector(dx.p[k], D), y = __builtin_convertvector(dy.p[k], D);
-    z.p[k] = __builtin_convertvector((a0 + dadx * x) + dady * y, typename simd::Native<N>::F);
+  if constexpr (kHalf == 8) {
+    // AVX-512: the 16 doubles are two registers, and GCC broadcasts into them directly.
+    using D = typename simd::Native<N>::D;
+    const D a0 = D{} + p.a0, dadx = D{} + p.dadx, dady = D{} + p.dady;
+    for (int k = 0; k < simd::Float<N>::kParts; ++k) {
+      D x = __builtin_convertvector(dx.p[k], D), y = __builtin_convertvector(dy.p[k], D);
+      z.p[k] = __builtin_convertvector((a0 + dadx * x) + dady * y, Fn);
+    }
+  } else {
+    using H = typename HalfLanes<sizeof(Fn)>::F;
+    using DH = typename HalfLanes<sizeof(Fn)>::D;
+    for (int k = 0; k < simd::Float<N>::kParts; ++k) {
+      const Fn x = dx.p[k], y = dy.p[k];
+      H low, high;
+      if constexpr (kHalf == 4) {
+        half_plane<H, DH>(p, __builtin_shufflevector(x, x, 0, 1, 2, 3),
+                          __builtin_shufflevector(y, y, 0, 1, 2, 3), low);
+        half_plane<H, DH>(p, __builtin_shufflevector(x, x, 4, 5, 6, 7),
+                          __builtin_shufflevector(y, y, 4, 5, 6, 7), high);
+        z.p[k] = __builtin_shufflevector(low, high, 0, 1, 2, 3, 4, 5, 6, 7);
+      } else {
+        static_assert(kHalf == 2);
+        half_plane<H, DH>(p, __builtin_shufflevector(x, x, 0, 1),
+                          __builtin_shufflevector(y, y, 0, 1), low);
+        half_plane<H, DH>(p, __builtin_shufflevector(x, x, 2, 3),
+                          __builtin_shufflevector(y, y, 2, 3), high);
+        z.p[k] = __builtin_shufflevector(low, high, 0, 1, 2, 3);
+      }
+    }
   }
   return z;
 }
