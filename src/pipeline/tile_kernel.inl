@@ -184,30 +184,26 @@ template <bool kLessEqual>
                                            kLessEqual ? _CMP_LE_OQ : _CMP_LT_OQ);
   _mm512_mask_storeu_ps(depth, pass, reinterpret_cast<__m512>(z));
   _mm512_mask_storeu_epi32(ids, pass, _mm512_set1_epi32(id));
-#elif SOFTRAST_LANES == 8
-  // AVX2: the winners' depth and id by masked stores (VMASKMOVPS, VPMASKMOVD), as AVX-512 does;
-  // blending into the loaded values and storing them whole read the ids for nothing.
-  __m256 stored = _mm256_loadu_ps(depth);
-  I bit = I{} + 1;
-  for (int l = 0; l < kLanes; ++l) bit[l] <<= l;
-  I covered = ((I{} + int32_t(mask)) & bit) != 0;
-  I pass = (kLessEqual ? (z <= reinterpret_cast<F>(stored)) : (z < reinterpret_cast<F>(stored))) &
-           covered;
-  _mm256_maskstore_ps(depth, reinterpret_cast<__m256i>(pass), reinterpret_cast<__m256>(z));
-  _mm256_maskstore_epi32(ids, reinterpret_cast<__m256i>(pass), _mm256_set1_epi32(id));
 #else
   F stored;
-  I winner;
   std::memcpy(&stored, depth, sizeof(F));
-  std::memcpy(&winner, ids, sizeof(I));
   I bit = I{} + 1;
   for (int l = 0; l < kLanes; ++l) bit[l] <<= l;
   I covered = ((I{} + int32_t(mask)) & bit) != 0;
   I pass = (kLessEqual ? (z <= stored) : (z < stored)) & covered;
+#if SOFTRAST_LANES == 8
+  // AVX2: the winners' depth and id by masked stores (VMASKMOVPS, VPMASKMOVD), as AVX-512 does;
+  // blending into the loaded values and storing them whole read the ids for nothing.
+  _mm256_maskstore_ps(depth, reinterpret_cast<__m256i>(pass), reinterpret_cast<__m256>(z));
+  _mm256_maskstore_epi32(ids, reinterpret_cast<__m256i>(pass), _mm256_set1_epi32(id));
+#else
+  I winner;
+  std::memcpy(&winner, ids, sizeof(I));
   stored = pass ? z : stored;
   winner = pass ? (I{} + id) : winner;
   std::memcpy(depth, &stored, sizeof(F));
   std::memcpy(ids, &winner, sizeof(I));
+#endif
 #endif
 }
 

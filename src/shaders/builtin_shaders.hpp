@@ -67,7 +67,6 @@ struct FlatShader {
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     if (f.opaque && !srgb) {  // one scalar pack instead of the fragment stage's 16-lane one
-
       f.set_rgba8(simd::Int<N>(int32_t(softrast::pack_rgba8(color))));
       return;
     }

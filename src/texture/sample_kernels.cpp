@@ -145,21 +145,11 @@ SOFTRAST_AVX512_FN void bilinear16_texels(const Texture& t, const Sampler& s, __
   }
   row0 = _mm512_add_epi32(offset, row0);
   row1 = _mm512_add_epi32(offset, row1);
-  const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
-  if (_mm512_cmpneq_epi32_mask(i1, _mm512_add_epi32(i0, one)) == 0) {
-    // No lane wraps between its columns: one 64-bit load per lane and row (sample_level).
-    using V = simd::Native<16>::I;
-    V lo, hi;
-    simd::isa::gather_pair(texels, V(_mm512_add_epi32(row0, i0)), lo, hi);
-    b0 = __m512i(lo), b1 = __m512i(hi);
-    simd::isa::gather_pair(texels, V(_mm512_add_epi32(row1, i0)), lo, hi);
-    t0 = __m512i(lo), t1 = __m512i(hi);
-  } else {
-    b0 = _mm512_i32gather_epi32(_mm512_add_epi32(row0, i0), texels, 4);
-    b1 = _mm512_i32gather_epi32(_mm512_add_epi32(row0, i1), texels, 4);
-    t0 = _mm512_i32gather_epi32(_mm512_add_epi32(row1, i0), texels, 4);
-    t1 = _mm512_i32gather_epi32(_mm512_add_epi32(row1, i1), texels, 4);
-  }
+  using V = simd::Native<16>::I;
+  V lb, rb, lt, rt;
+  avx512::gather_bilinear16(reinterpret_cast<const int32_t*>(t.texels()), V(row0), V(row1), V(i0),
+                            V(i1), lb, rb, lt, rt);
+  b0 = __m512i(lb), b1 = __m512i(rb), t0 = __m512i(lt), t1 = __m512i(rt);
 }
 
 SOFTRAST_AVX512_FN Texels16 bilinear16(const Texture& t, const Sampler& s, __m512 u, __m512 v,

@@ -228,13 +228,37 @@ SOFTRAST_AVX512_SAMPLER __m512i wrap_clamp_or_repeat16(Wrap mode, __m512i i, int
   return __m512i(x & last);
 }
 
-// The four texels (bilinear_texels) and the weights' fractions of 16 lanes where
-// bilinear_rgba8_applies.
-SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const Texture& t, const Sampler& s, __m512 u,
-                                               __m512 v, simd::Int<16>& b0, simd::Int<16>& b1,
-                                               simd::Int<16>& t0, simd::Int<16>& t1,
-                                               simd::Float<16>& fxl, simd::Float<16>& fyl) {
+// The four texels of each lane from its rows' first texels and its two columns: one 64-bit load
+// per lane and row where no lane wraps between its columns (sample_level), else four gathers.
+// (Also the out-of-line kernel's, sample_kernels.cpp.)
+SOFTRAST_AVX512_SAMPLER void gather_bilinear16(
+    const int32_t* texels, const simd::Native<16>::I& row0, const simd::Native<16>::I& row1,
+    const simd::Native<16>::I& i0, const simd::Native<16>::I& i1, simd::Native<16>::I& b0,
+    simd::Native<16>::I& b1, simd::Native<16>::I& t0, simd::Native<16>::I& t1) {
   using V = simd::Native<16>::I;
+  if (_mm512_cmpneq_epi32_mask(__m512i(i1), __m512i(i0 + 1)) == 0) {
+    simd::isa::gather_pair(texels, row0 + i0, b0, b1);
+    simd::isa::gather_pair(texels, row1 + i0, t0, t1);
+    return;
+  }
+  const __m512i zero = _mm512_setzero_si512();
+  const __mmask16 all = 0xffff;
+  b0 = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row0 + i0), texels, 4));
+  b1 = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row0 + i1), texels, 4));
+  t0 = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row1 + i0), texels, 4));
+  t1 = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row1 + i1), texels, 4));
+}
+
+// The four texels (bilinear_texels) and the weights' fractions of 16 lanes where
+// bilinear_rgba8_applies. Everything by reference: a caller compiled for the baseline (a test,
+// say) that does not inline this would pass 64-byte vectors in memory where it expects registers.
+SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const Texture& t, const Sampler& s,
+                                               const simd::Vec2<16>& uv, simd::Int<16>& b0,
+                                               simd::Int<16>& b1, simd::Int<16>& t0,
+                                               simd::Int<16>& t1, simd::Float<16>& fxl,
+                                               simd::Float<16>& fyl) {
+  using V = simd::Native<16>::I;
+  const __m512 u = __m512(uv.x.p[0]), v = __m512(uv.y.p[0]);
   const int w = t.width(), h = t.height();
   __m512 fx, fy;
   __m512i x0 =
@@ -255,39 +279,10 @@ SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const Texture& t, const Sampler& 
     row0 = j0 * w;
     row1 = j1 * w;
   }
-  const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
-  if (_mm512_cmpneq_epi32_mask(__m512i(i1), __m512i(i0 + 1)) == 0) {
-    // No lane wraps between its columns: one 64-bit load per lane and row (sample_level).
-    simd::isa::gather_pair(texels, row0 + i0, b0.p[0], b1.p[0]);
-    simd::isa::gather_pair(texels, row1 + i0, t0.p[0], t1.p[0]);
-  } else {
-    const __m512i zero = _mm512_setzero_si512();
-    const __mmask16 all = 0xffff;
-    b0.p[0] = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row0 + i0), texels, 4));
-    b1.p[0] = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row0 + i1), texels, 4));
-    t0.p[0] = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row1 + i0), texels, 4));
-    t1.p[0] = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row1 + i1), texels, 4));
-  }
+  gather_bilinear16(reinterpret_cast<const int32_t*>(t.texels()), row0, row1, i0, i1, b0.p[0],
+                    b1.p[0], t0.p[0], t1.p[0]);
   fxl.p[0] = simd::Native<16>::F(fx);
   fyl.p[0] = simd::Native<16>::F(fy);
-}
-
-// sample_rgba8 and sample (below) of 16 lanes where bilinear_rgba8_applies. Arguments and
-// results by reference: a caller compiled for the baseline (a test, say) that does not inline
-// these passes 64-byte vectors in memory where they expect registers.
-SOFTRAST_AVX512_SAMPLER void bilinear_rgba8_packed(const Texture& t, const Sampler& s,
-                                                   const simd::Vec2<16>& uv, simd::Int<16>& out) {
-  simd::Int<16> b0, b1, t0, t1;
-  simd::Float<16> fx, fy;
-  bilinear_texels16(t, s, __m512(uv.x.p[0]), __m512(uv.y.p[0]), b0, b1, t0, t1, fx, fy);
-  out = filter_rgba8_packed<16>(b0, b1, t0, t1, fx, fy);
-}
-SOFTRAST_AVX512_SAMPLER void bilinear_rgba8_float(const Texture& t, const Sampler& s,
-                                                  const simd::Vec2<16>& uv, simd::Vec4<16>& out) {
-  simd::Int<16> b0, b1, t0, t1;
-  simd::Float<16> fx, fy;
-  bilinear_texels16(t, s, __m512(uv.x.p[0]), __m512(uv.y.p[0]), b0, b1, t0, t1, fx, fy);
-  out = filter_rgba8<16>(b0, b1, t0, t1, fx, fy);
 }
 
 #undef SOFTRAST_AVX512_SAMPLER
@@ -509,9 +504,10 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler&
   if (texture.empty()) return {F(1.0f), F(1.0f), F(1.0f), F(1.0f)};
   if constexpr (N == 16) {
     if (detail::avx512::bilinear_rgba8_applies(texture, s)) {
-      simd::Vec4<N> c;
-      detail::avx512::bilinear_rgba8_float(texture, s, uv, c);
-      return c;
+      simd::Int<N> b0, b1, t0, t1;
+      F fx, fy;
+      detail::avx512::bilinear_texels16(texture, s, uv, b0, b1, t0, t1, fx, fy);
+      return detail::filter_rgba8<N>(b0, b1, t0, t1, fx, fy);
     }
   }
   detail::SampleLanes io;
@@ -530,9 +526,10 @@ SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8(const Texture& texture, const Sam
   if (texture.empty()) return simd::Int<N>(-1);  // opaque white
   if constexpr (N == 16) {
     if (detail::avx512::bilinear_rgba8_applies(texture, s)) {
-      simd::Int<N> packed;
-      detail::avx512::bilinear_rgba8_packed(texture, s, uv, packed);
-      return packed;
+      simd::Int<N> b0, b1, t0, t1;
+      simd::Float<N> fx, fy;
+      detail::avx512::bilinear_texels16(texture, s, uv, b0, b1, t0, t1, fx, fy);
+      return detail::filter_rgba8_packed<N>(b0, b1, t0, t1, fx, fy);
     }
   }
   detail::SampleLanes io;
