@@ -22,6 +22,7 @@
 // order.
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <memory>
 #include <span>
@@ -67,6 +68,7 @@ struct DrawCache {
   WindowVertices vertices;
   std::vector<Chunk> chunks;
   std::vector<std::unique_ptr<DeferredScratch>> scratch;  // per tile worker
+  std::vector<std::pair<uint32_t, uint32_t>> tile_order;   // (records, tile), busiest first
 };
 
 DrawCache& draw_cache() {
@@ -219,12 +221,22 @@ class BinnedDraw {
         if (cache_.scratch[w]->interps.size() < records) cache_.scratch[w]->interps.resize(records);
       }
     }
+    // Several workers take the tiles with the most records first, so that the last tiles taken
+    // are short ones and no worker is left alone with a long tile at the end of the phase.
+    std::vector<std::pair<uint32_t, uint32_t>>& order = cache_.tile_order;
+    order.clear();
+    for (size_t tile = 0; tile < tiles; ++tile) {
+      size_t records = 0;
+      for (const Chunk& chunk : chunks()) records += chunk.bins[tile].size();
+      if (records != 0) order.emplace_back(uint32_t(~std::bit_width(records)), uint32_t(tile));
+    }
+    if (workers > 1) std::sort(order.begin(), order.end());
     std::atomic<size_t> next{0};
     parallel_for(workers, threads_, [&](size_t worker) {
-      for (size_t tile = next.fetch_add(1); tile < tiles; tile = next.fetch_add(1)) {
+      for (size_t k = next.fetch_add(1); k < order.size(); k = next.fetch_add(1)) {
+        size_t tile = order[k].second;
         auto start = state_.tile_times ? std::chrono::steady_clock::now()
                                        : std::chrono::steady_clock::time_point{};
-        if (!has_records(tile)) continue;
         // A clear still pending on the tile is written now, into the cache the tile is drawn in.
         target_.framebuffer->prepare_tile(int(tile % size_t(tiles_x_)),
                                           int(tile / size_t(tiles_x_)));
@@ -239,13 +251,6 @@ class BinnedDraw {
         }
       }
     });
-  }
-
-  bool has_records(size_t tile) const {
-    for (const Chunk& chunk : chunks()) {
-      if (!chunk.bins[tile].empty()) return true;
-    }
-    return false;
   }
 
   // Deferred shading pays for its visibility pass only where triangles overlap: a tile whose
