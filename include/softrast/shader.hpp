@@ -80,7 +80,7 @@ template <ShaderProgram S>
 void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
           std::span<const uint32_t> indices, uint32_t vertex_count) {
   constexpr int kStride = 4 + S::kVaryings;
-  constexpr uint32_t kVerticesPerJob = 4096;
+  constexpr uint32_t kVerticesPerJob = 1024;
   // The vertex stage's output, kept per thread and per shader type between draws: a scene drawn
   // again allocates nothing (the vector only grows; every element used is written below).
   thread_local std::vector<float> clip;

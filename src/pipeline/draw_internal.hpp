@@ -49,7 +49,7 @@ class WindowVertices {
  public:
   // Transforms the geometry's vertices in jobs of kPerJob on `threads` threads.
   void transform(const GeometryStage& geometry, int threads) {
-    constexpr size_t kPerJob = 8192;
+    constexpr size_t kPerJob = 1024;
     const size_t n = geometry.vertex_count();
     window_.resize(n);
     codes_.resize(n);
