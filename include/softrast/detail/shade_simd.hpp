@@ -367,47 +367,118 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   simd::select(f.live, packed, old).store(color_at);
 }
 
+// Where shade_mixed_wide's lanes find their triangles' plane coefficients: x_ref(), y_ref(),
+// inv_w(j) (a0, dadx, dady for j = 0, 1, 2) and var(i, j), each a vector whose lane l holds the
+// coefficient of the triangle that covers pixel l (triangle 0's where none does: finite, never
+// written). Two sources give the same values (copies, no arithmetic).
+
+// Any number of triangles: the coefficients as a table in memory (entry k of a row: triangle
+// k's), one permute per row.
+template <class S, int N>
+struct MixedTable {
+  using F = simd::Float<N>;
+  using I = simd::Int<N>;
+  static constexpr int kN = S::kVaryings > 0 ? S::kVaryings : 1;
+  enum { kXRef, kYRef, kInvW, kVar = kInvW + 3, kRows = kVar + 3 * kN };
+  alignas(64) float table[kRows][16];
+  I lane_winner;
+
+  SOFTRAST_SIMD_INLINE explicit MixedTable(const MixedBlock& block) : lane_winner(0) {
+    for (int k = 0; k < block.count; ++k) {
+      const Interpolants& in = *block.winner[k];
+      table[kXRef][k] = in.x_ref;
+      table[kYRef][k] = in.y_ref;
+      table[kInvW][k] = in.inv_w.a0;
+      table[kInvW + 1][k] = in.inv_w.dadx;
+      table[kInvW + 2][k] = in.inv_w.dady;
+      for (int i = 0; i < S::kVaryings; ++i) {
+        table[kVar + 3 * i][k] = in.var[i].a0;
+        table[kVar + 3 * i + 1][k] = in.var[i].dadx;
+        table[kVar + 3 * i + 2][k] = in.var[i].dady;
+      }
+      lane_winner = simd::select(simd::lanes_of<N>(block.mask[k]), I(k), lane_winner);
+    }
+  }
+  SOFTRAST_SIMD_INLINE F row(int r) const { return simd::lookup16<N>(table[r], lane_winner); }
+  SOFTRAST_SIMD_INLINE F x_ref() const { return row(kXRef); }
+  SOFTRAST_SIMD_INLINE F y_ref() const { return row(kYRef); }
+  SOFTRAST_SIMD_INLINE F inv_w(int j) const { return row(kInvW + j); }
+  SOFTRAST_SIMD_INLINE F var(int i, int j) const { return row(kVar + 3 * i + j); }
+};
+
+// Two triangles at AVX-512 (most blocks of several: a mesh's edges cut blocks in two): each
+// triangle's Interpolants read whole, 16 floats to a register, and a coefficient of all lanes one
+// two-source permute (VPERMT2PS) of the two triangles' registers. The table above is written
+// float by float and read back 64 bytes at a time, which the store buffer cannot forward: its
+// loads wait for every store before them. (Three or four triangles by two permutes and a blend
+// measured no faster than the table: diablo3 2.845 / 2.848 ms.)
+template <class S>
+struct MixedPair16 {
+  using F = simd::Float<16>;
+  using V = simd::Native<16>::F;
+  // Float offsets of the coefficients in Interpolants, and how many floats they span.
+  static constexpr int kXRef = int(offsetof(Interpolants, x_ref) / sizeof(float));
+  static constexpr int kYRef = int(offsetof(Interpolants, y_ref) / sizeof(float));
+  static constexpr int kInvW = int(offsetof(Interpolants, inv_w) / sizeof(float));
+  static constexpr int kVar = int(offsetof(Interpolants, var) / sizeof(float));
+  static constexpr int kFloats = kVar + 3 * S::kVaryings;
+  static constexpr int kChunks = (kFloats + 15) / 16;
+  static_assert(sizeof(Plane) == 3 * sizeof(float) && offsetof(Interpolants, x_ref) % 4 == 0 &&
+                offsetof(Interpolants, inv_w) % 4 == 0 && offsetof(Interpolants, var) % 4 == 0);
+  V chunk[2][kChunks];            // triangle k's floats [16 c, 16 c + 16)
+  simd::Native<16>::I odd_lanes;  // 16 where triangle 1 covers the lane (bit 4 of the index)
+
+  // The intrinsics are in functions of their own, with the target and their results by
+  // reference, as in simd::isa: inlined by the AVX-512 block function's `flatten`.
+  SOFTRAST_SIMD_INLINE explicit MixedPair16(const MixedBlock& block) { load(block); }
+  [[gnu::target("avx512f")]] inline void load(const MixedBlock& block) {
+    for (int k = 0; k < 2; ++k) {
+      // Only the Interpolants' first kFloats floats: a record ends after its varyings.
+      const float* from = reinterpret_cast<const float*>(block.winner[k]);
+      for (int c = 0; c < kChunks; ++c) {
+        const int left = kFloats - 16 * c;
+        const __mmask16 lanes = left >= 16 ? __mmask16(0xffff) : __mmask16((1u << left) - 1u);
+        chunk[k][c] = V(_mm512_maskz_loadu_ps(lanes, from + 16 * c));
+      }
+    }
+    odd_lanes = simd::Native<16>::I(
+        _mm512_maskz_mov_epi32(__mmask16(block.mask[1]), _mm512_set1_epi32(16)));
+  }
+  [[gnu::target("avx512f")]] inline void at(int field, V& r) const {
+    const __m512i index = _mm512_add_epi32(__m512i(odd_lanes), _mm512_set1_epi32(field % 16));
+    r = V(
+        _mm512_permutex2var_ps(__m512(chunk[0][field / 16]), index, __m512(chunk[1][field / 16])));
+  }
+  SOFTRAST_SIMD_INLINE F field(int i) const {
+    F r;
+    at(i, r.p[0]);
+    return r;
+  }
+  SOFTRAST_SIMD_INLINE F x_ref() const { return field(kXRef); }
+  SOFTRAST_SIMD_INLINE F y_ref() const { return field(kYRef); }
+  SOFTRAST_SIMD_INLINE F inv_w(int j) const { return field(kInvW + j); }
+  SOFTRAST_SIMD_INLINE F var(int i, int j) const { return field(kVar + 3 * i + j); }
+};
+
 // Shades a block whose pixels several triangles of one facing cover (MixedBlock) with shader S
-// on N-lane vectors. Each lane looks its own triangle's plane coefficients up, and then runs
-// shade_block_wide's operations in the same order: every pixel gets the bits its
+// on N-lane vectors. Each lane takes its own triangle's plane coefficients (`coef`, above), and
+// then runs shade_block_wide's operations in the same order: every pixel gets the bits its
 // triangle's own call would give it. Resolved (deferred tiles): the pixels are the ones each
 // triangle won, and their depth is already in the framebuffer (the value that call would
 // compute). Otherwise (immediate tiles, BlockBatch): the triangles cover disjoint pixels, and
 // each lane is depth-tested and written as that call would do it.
-template <class S, int N>
-SOFTRAST_SIMD_INLINE void shade_mixed_wide(const S& shader, const ShadeTarget& target,
-                                           const MixedBlock& block, int x, int y) {
+template <class S, int N, class Coefficients>
+SOFTRAST_SIMD_INLINE void shade_mixed_with(const S& shader, const ShadeTarget& target,
+                                           const MixedBlock& block, int x, int y,
+                                           const Coefficients& coef) {
   using F = simd::Float<N>;
   using I = simd::Int<N>;
   constexpr int kN = S::kVaryings > 0 ? S::kVaryings : 1;
   Framebuffer& fb = *target.framebuffer;
-
-  // The triangles' coefficients as tables (entry k: triangle k), and each lane's triangle; a
-  // coefficient of all lanes is then one permute, however many triangles share the block. Lanes
-  // no triangle covers take triangle 0's (finite, never written); entries past block.count are
-  // never looked up.
-  enum { kXRef, kYRef, kInvW, kVar = kInvW + 3, kRows = kVar + 3 * kN };
-  alignas(64) float table[kRows][16];
-  I lane_winner(0);
   uint32_t all = 0;
-  for (int k = 0; k < block.count; ++k) {
-    const Interpolants& in = *block.winner[k];
-    table[kXRef][k] = in.x_ref;
-    table[kYRef][k] = in.y_ref;
-    table[kInvW][k] = in.inv_w.a0;
-    table[kInvW + 1][k] = in.inv_w.dadx;
-    table[kInvW + 2][k] = in.inv_w.dady;
-    for (int i = 0; i < S::kVaryings; ++i) {
-      table[kVar + 3 * i][k] = in.var[i].a0;
-      table[kVar + 3 * i + 1][k] = in.var[i].dadx;
-      table[kVar + 3 * i + 2][k] = in.var[i].dady;
-    }
-    lane_winner = simd::select(simd::lanes_of<N>(block.mask[k]), I(k), lane_winner);
-    all |= block.mask[k];
-  }
-  auto per_lane = [&](int row) { return simd::lookup16<N>(table[row], lane_winner); };
-  const F x_ref = per_lane(kXRef), y_ref = per_lane(kYRef);
-  const F a0 = per_lane(kInvW), dadx = per_lane(kInvW + 1), dady = per_lane(kInvW + 2);
+  for (int k = 0; k < block.count; ++k) all |= block.mask[k];
+  const F x_ref = coef.x_ref(), y_ref = coef.y_ref();
+  const F a0 = coef.inv_w(0), dadx = coef.inv_w(1), dady = coef.inv_w(2);
 
   Fragments<N> f;
   f.x = simd::to_float(I(x) + simd::lane_column<N>()) + F(0.5f);
@@ -441,9 +512,7 @@ SOFTRAST_SIMD_INLINE void shade_mixed_wide(const S& shader, const ShadeTarget& t
   F w = F(1.0f) / inv_w;
   F var[kN];
   for (int i = 0; i < S::kVaryings; ++i) {
-    var[i] = (per_lane(kVar + 3 * i) + per_lane(kVar + 3 * i + 1) * dx +
-              per_lane(kVar + 3 * i + 2) * dy) *
-             w;
+    var[i] = (coef.var(i, 0) + coef.var(i, 1) * dx + coef.var(i, 2) * dy) * w;
   }
   f.varyings = var;
   f.front_facing = block.front_facing;
@@ -461,6 +530,18 @@ SOFTRAST_SIMD_INLINE void shade_mixed_wide(const S& shader, const ShadeTarget& t
     return;
   }
   simd::select(f.live, packed, I::load(color_at)).store(color_at);
+}
+
+template <class S, int N>
+SOFTRAST_SIMD_INLINE void shade_mixed_wide(const S& shader, const ShadeTarget& target,
+                                           const MixedBlock& block, int x, int y) {
+  if constexpr (N == 16) {
+    if (block.count == 2) {
+      shade_mixed_with<S, N>(shader, target, block, x, y, MixedPair16<S>(block));
+      return;
+    }
+  }
+  shade_mixed_with<S, N>(shader, target, block, x, y, MixedTable<S, N>(block));
 }
 
 template <class S, int N>
