@@ -187,7 +187,7 @@ double rsqrt_worst_error<4>(const std::vector<float>& xs) {
   return rsqrt_worst_error_impl<4>(xs);
 }
 template <>
-[[gnu::target("avx2")]] double rsqrt_worst_error<8>(const std::vector<float>& xs) {
+[[gnu::target("avx2,fma")]] double rsqrt_worst_error<8>(const std::vector<float>& xs) {
   return rsqrt_worst_error_impl<8>(xs);
 }
 template <>
@@ -213,6 +213,66 @@ TEST(SimdRsqrt, WithinAFewUnitsInTheLastPlaceAtEveryLevel) {
   if (cpu_simd_level() >= SimdLevel::kAvx512) {
     EXPECT_LT(rsqrt_worst_error<16>(xs), bound);
   }
+}
+
+// simd::fma at one level over the lanes of a, b, c: how many lanes differ from `expected`.
+template <int N>
+int fma_mismatches(const float* a, const float* b, const float* c, const float* expected);
+template <int N>
+int fma_mismatches_impl(const float* a, const float* b, const float* c, const float* expected) {
+  simd::Float<N> x, y, z;
+  for (int i = 0; i < simd::kLanes; ++i) {
+    x.set_lane(i, a[i]);
+    y.set_lane(i, b[i]);
+    z.set_lane(i, c[i]);
+  }
+  simd::Float<N> r = simd::fma(x, y, z);
+  int mismatches = 0;
+  for (int i = 0; i < simd::kLanes; ++i) mismatches += r.lane(i) != expected[i];
+  return mismatches;
+}
+template <>
+int fma_mismatches<4>(const float* a, const float* b, const float* c, const float* expected) {
+  return fma_mismatches_impl<4>(a, b, c, expected);
+}
+template <>
+[[gnu::target("avx2,fma")]] int fma_mismatches<8>(const float* a, const float* b, const float* c,
+                                                  const float* expected) {
+  return fma_mismatches_impl<8>(a, b, c, expected);
+}
+template <>
+[[gnu::target("avx512f,avx512bw,avx512dq,avx512vl")]] int fma_mismatches<16>(
+    const float* a, const float* b, const float* c, const float* expected) {
+  return fma_mismatches_impl<16>(a, b, c, expected);
+}
+
+// simd::fma rounds once where the level has FMA (AVX2, AVX-512: std::fma's result) and twice at
+// SSE (a * b, then + c), on operands where the two differ.
+TEST(SimdFma, FusedWhereTheLevelHasFma) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  int differ = 0;
+  for (int round = 0; round < 256; ++round) {
+    float a[simd::kLanes], b[simd::kLanes], c[simd::kLanes], fused[simd::kLanes],
+        twice[simd::kLanes];
+    for (int i = 0; i < simd::kLanes; ++i) {
+      a[i] = unit(rng);
+      b[i] = unit(rng);
+      c[i] = -a[i] * b[i] + unit(rng) * 1.0e-3f;  // cancellation: the product's rounding shows
+      fused[i] = std::fma(a[i], b[i], c[i]);
+      volatile float product = a[i] * b[i];
+      twice[i] = product + c[i];
+      differ += fused[i] != twice[i];
+    }
+    EXPECT_EQ(fma_mismatches<4>(a, b, c, twice), 0);
+    if (cpu_simd_level() >= SimdLevel::kAvx2) {
+      EXPECT_EQ(fma_mismatches<8>(a, b, c, fused), 0);
+    }
+    if (cpu_simd_level() >= SimdLevel::kAvx512) {
+      EXPECT_EQ(fma_mismatches<16>(a, b, c, fused), 0);
+    }
+  }
+  EXPECT_GT(differ, 1000);  // the operands do tell the two apart
 }
 
 TEST(SimdSampler, MatchesScalarSamplingBitForBitAtEveryLevel) {

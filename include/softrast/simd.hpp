@@ -401,6 +401,21 @@ inline void sqrt(const Native<4>::F& a, Native<4>::F& r) {
       _mm512_maskz_sqrt_ps(__mmask16(0xffff), __m512(a)));  // maskz: no undefined source
 }
 
+// r = a * b + c, fused (one rounding) where the level has FMA (AVX2 with FMA, AVX-512); two
+// roundings at SSE2 and SSE4, so the levels may differ in the last bit.
+inline void fmadd(const Native<4>::F& a, const Native<4>::F& b, const Native<4>::F& c,
+                  Native<4>::F& r) {
+  r = a * b + c;
+}
+[[gnu::target("avx2,fma")]] inline void fmadd(const Native<8>::F& a, const Native<8>::F& b,
+                                              const Native<8>::F& c, Native<8>::F& r) {
+  r = Native<8>::F(_mm256_fmadd_ps(__m256(a), __m256(b), __m256(c)));
+}
+[[gnu::target("avx512f")]] inline void fmadd(const Native<16>::F& a, const Native<16>::F& b,
+                                             const Native<16>::F& c, Native<16>::F& r) {
+  r = Native<16>::F(_mm512_maskz_fmadd_ps(__mmask16(0xffff), __m512(a), __m512(b), __m512(c)));
+}
+
 // r ~ 1 / sqrt(a): the instruction's estimate (relative error below 1.5 * 2^-12, AVX-512's below
 // 2^-14). The Newton step that makes it a float is in simd::rsqrt.
 inline void rsqrt_estimate(const Native<4>::F& a, Native<4>::F& r) {
@@ -572,6 +587,15 @@ SOFTRAST_SIMD_INLINE Float<N> sqrt(const Float<N>& a) {
   return r;
 }
 
+// a * b + c, rounded once where the level has FMA (isa::fmadd): for lighting and the like, whose
+// results may differ by a bit between levels, never for coverage, depth or texel addresses.
+template <int N>
+SOFTRAST_SIMD_INLINE Float<N> fma(const Float<N>& a, const Float<N>& b, const Float<N>& c) {
+  Float<N> r;
+  for (int k = 0; k < Float<N>::kParts; ++k) isa::fmadd(a.p[k], b.p[k], c.p[k], r.p[k]);
+  return r;
+}
+
 // 1 / sqrt(a) within a few units in the last place (the estimate and one Newton step), for
 // positive finite a (0 gives NaN). Much faster than 1 / sqrt(a): the square
 // root and the division share one divider that takes a 16-lane operation every 10 to 16 cycles,
@@ -580,7 +604,8 @@ template <int N>
 SOFTRAST_SIMD_INLINE Float<N> rsqrt(const Float<N>& a) {
   Float<N> y;
   for (int k = 0; k < Float<N>::kParts; ++k) isa::rsqrt_estimate(a.p[k], y.p[k]);
-  return y * (Float<N>(1.5f) - Float<N>(0.5f) * a * y * y);
+  const Float<N> half_a_y = Float<N>(0.5f) * a * y;
+  return y * fma(-half_a_y, y, Float<N>(1.5f));
 }
 
 // Bit i set where lane i of the mask is set (its sign bit).
@@ -694,7 +719,7 @@ SOFTRAST_SIMD_INLINE Vec3<N> splat3(const V3& v) {
 
 template <int N>
 SOFTRAST_SIMD_INLINE Float<N> dot(const Vec3<N>& a, const Vec3<N>& b) {
-  return a.x * b.x + a.y * b.y + a.z * b.z;
+  return fma(a.z, b.z, fma(a.y, b.y, a.x * b.x));
 }
 // v / |v| as glm::normalize computes it: v * (1 / sqrt(dot(v, v))).
 template <int N>

@@ -229,10 +229,10 @@ struct PhongShader {
     }
     F visible =
         lighting.shadow ? shadow_visibility<N>(*lighting.shadow, p, simd::dot(n, l)) : F(1.0f);
-    F lit = F(lighting.ambient) + F(lighting.diffuse) * light.diffuse * visible;
+    F lit = simd::fma(F(lighting.diffuse) * light.diffuse, visible, F(lighting.ambient));
     F spec = light.specular * visible;
-    f.color = {base.x * lit + ks.x * spec, base.y * lit + ks.y * spec, base.z * lit + ks.z * spec,
-               a};
+    f.color = {simd::fma(base.x, lit, ks.x * spec), simd::fma(base.y, lit, ks.y * spec),
+               simd::fma(base.z, lit, ks.z * spec), a};
     if (lighting.srgb_output) f.color = encode_srgb<N>(f.color);
   }
 };

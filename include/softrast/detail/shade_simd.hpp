@@ -579,10 +579,10 @@ template <class S>
   shade_block_level<S, 4>(shader, target, interp, x, y, mask);
 }
 template <class S>
-[[gnu::target("avx2"), gnu::flatten]] void shade_block_avx2(const void* shader,
-                                                            const ShadeTarget& target,
-                                                            const Interpolants& interp, int x,
-                                                            int y, uint32_t mask) {
+[[gnu::target("avx2,fma"), gnu::flatten]] void shade_block_avx2(const void* shader,
+                                                                const ShadeTarget& target,
+                                                                const Interpolants& interp, int x,
+                                                                int y, uint32_t mask) {
   shade_block_level<S, 8>(shader, target, interp, x, y, mask);
 }
 template <class S>
@@ -605,9 +605,10 @@ template <class S>
   shade_mixed_wide<S, 4>(*static_cast<const S*>(shader), target, block, x, y);
 }
 template <class S>
-[[gnu::target("avx2"), gnu::flatten]] void shade_mixed_avx2(const void* shader,
-                                                            const ShadeTarget& target,
-                                                            const MixedBlock& block, int x, int y) {
+[[gnu::target("avx2,fma"), gnu::flatten]] void shade_mixed_avx2(const void* shader,
+                                                                const ShadeTarget& target,
+                                                                const MixedBlock& block, int x,
+                                                                int y) {
   shade_mixed_wide<S, 8>(*static_cast<const S*>(shader), target, block, x, y);
 }
 template <class S>
