@@ -406,58 +406,34 @@ struct MixedTable {
   SOFTRAST_SIMD_INLINE F var(int i, int j) const { return row(kVar + 3 * i + j); }
 };
 
-// Two triangles at AVX-512 (most blocks of several: a mesh's edges cut blocks in two): each
-// triangle's Interpolants read whole, 16 floats to a register, and a coefficient of all lanes one
-// two-source permute (VPERMT2PS) of the two triangles' registers. The table above is written
-// float by float and read back 64 bytes at a time, which the store buffer cannot forward: its
-// loads wait for every store before them. (Three or four triangles by two permutes and a blend
-// measured no faster than the table: diablo3 2.845 / 2.848 ms.)
-template <class S>
-struct MixedPair16 {
-  using F = simd::Float<16>;
-  using V = simd::Native<16>::F;
-  // Float offsets of the coefficients in Interpolants, and how many floats they span.
-  static constexpr int kXRef = int(offsetof(Interpolants, x_ref) / sizeof(float));
-  static constexpr int kYRef = int(offsetof(Interpolants, y_ref) / sizeof(float));
-  static constexpr int kInvW = int(offsetof(Interpolants, inv_w) / sizeof(float));
-  static constexpr int kVar = int(offsetof(Interpolants, var) / sizeof(float));
-  static constexpr int kFloats = kVar + 3 * S::kVaryings;
-  static constexpr int kChunks = (kFloats + 15) / 16;
-  static_assert(sizeof(Plane) == 3 * sizeof(float) && offsetof(Interpolants, x_ref) % 4 == 0 &&
-                offsetof(Interpolants, inv_w) % 4 == 0 && offsetof(Interpolants, var) % 4 == 0);
-  V chunk[2][kChunks];            // triangle k's floats [16 c, 16 c + 16)
-  simd::Native<16>::I odd_lanes;  // 16 where triangle 1 covers the lane (bit 4 of the index)
+// Two triangles (most blocks of several: a mesh's edges cut blocks in two): each coefficient
+// broadcast from the two records and blended by the second triangle's lanes, one blend per
+// register. The table above is written float by float and read back 64 bytes at a time, which
+// the store buffer cannot forward: its loads wait for every store before them. (At AVX-512, two
+// records loaded whole and one two-source permute per coefficient measured the same as this;
+// three or four triangles by two permutes and a blend, no faster than the table.)
+template <class S, int N>
+struct MixedPair {
+  using F = simd::Float<N>;
+  const Interpolants& first;
+  const Interpolants& second;
+  simd::Int<N> second_lanes;
 
-  // The intrinsics are in functions of their own, with the target and their results by
-  // reference, as in simd::isa: inlined by the AVX-512 block function's `flatten`.
-  SOFTRAST_SIMD_INLINE explicit MixedPair16(const MixedBlock& block) { load(block); }
-  [[gnu::target("avx512f")]] inline void load(const MixedBlock& block) {
-    for (int k = 0; k < 2; ++k) {
-      // Only the Interpolants' first kFloats floats: a record ends after its varyings.
-      const float* from = reinterpret_cast<const float*>(block.winner[k]);
-      for (int c = 0; c < kChunks; ++c) {
-        const int left = kFloats - 16 * c;
-        const __mmask16 lanes = left >= 16 ? __mmask16(0xffff) : __mmask16((1u << left) - 1u);
-        chunk[k][c] = V(_mm512_maskz_loadu_ps(lanes, from + 16 * c));
-      }
-    }
-    odd_lanes = simd::Native<16>::I(
-        _mm512_maskz_mov_epi32(__mmask16(block.mask[1]), _mm512_set1_epi32(16)));
+  SOFTRAST_SIMD_INLINE explicit MixedPair(const MixedBlock& block)
+      : first(*block.winner[0]),
+        second(*block.winner[1]),
+        second_lanes(simd::lanes_of<N>(block.mask[1])) {}
+  SOFTRAST_SIMD_INLINE F pick(float a, float b) const {
+    return simd::select(second_lanes, F(b), F(a));
   }
-  [[gnu::target("avx512f")]] inline void at(int field, V& r) const {
-    const __m512i index = _mm512_add_epi32(__m512i(odd_lanes), _mm512_set1_epi32(field % 16));
-    r = V(
-        _mm512_permutex2var_ps(__m512(chunk[0][field / 16]), index, __m512(chunk[1][field / 16])));
+  SOFTRAST_SIMD_INLINE F x_ref() const { return pick(first.x_ref, second.x_ref); }
+  SOFTRAST_SIMD_INLINE F y_ref() const { return pick(first.y_ref, second.y_ref); }
+  SOFTRAST_SIMD_INLINE F inv_w(int j) const {
+    return pick((&first.inv_w.a0)[j], (&second.inv_w.a0)[j]);
   }
-  SOFTRAST_SIMD_INLINE F field(int i) const {
-    F r;
-    at(i, r.p[0]);
-    return r;
+  SOFTRAST_SIMD_INLINE F var(int i, int j) const {
+    return pick((&first.var[i].a0)[j], (&second.var[i].a0)[j]);
   }
-  SOFTRAST_SIMD_INLINE F x_ref() const { return field(kXRef); }
-  SOFTRAST_SIMD_INLINE F y_ref() const { return field(kYRef); }
-  SOFTRAST_SIMD_INLINE F inv_w(int j) const { return field(kInvW + j); }
-  SOFTRAST_SIMD_INLINE F var(int i, int j) const { return field(kVar + 3 * i + j); }
 };
 
 // Shades a block whose pixels several triangles of one facing cover (MixedBlock) with shader S
@@ -535,11 +511,9 @@ SOFTRAST_SIMD_INLINE void shade_mixed_with(const S& shader, const ShadeTarget& t
 template <class S, int N>
 SOFTRAST_SIMD_INLINE void shade_mixed_wide(const S& shader, const ShadeTarget& target,
                                            const MixedBlock& block, int x, int y) {
-  if constexpr (N == 16) {
-    if (block.count == 2) {
-      shade_mixed_with<S, N>(shader, target, block, x, y, MixedPair16<S>(block));
-      return;
-    }
+  if (block.count == 2) {
+    shade_mixed_with<S, N>(shader, target, block, x, y, MixedPair<S, N>(block));
+    return;
   }
   shade_mixed_with<S, N>(shader, target, block, x, y, MixedTable<S, N>(block));
 }
