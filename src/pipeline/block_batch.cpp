@@ -4,11 +4,16 @@
 namespace softrast::detail {
 
 void BlockBatch::add(const Interpolants& in, int x, int y, uint32_t mask) {
-  Slot& slot = slot_of(x, y);
+  const int index = slot_index(x, y);
+  if (mask == 0xffffu && !holds(index)) {  // a whole block, nothing held where it goes
+    program_->shade_block(program_->shader, *target_, in, x, y, mask);
+    return;
+  }
+  Slot& slot = slots_[index];
   MixedBlock& held = slot.block;
-  bool same_block = held.count != 0 && slot.x == x && slot.y == y;
+  bool same_block = holds(index) && slot.x == x && slot.y == y;
   if (mask == 0xffffu) {  // a whole block: nothing to share it with
-    if (same_block) shade(slot);
+    if (same_block) shade(index);
     program_->shade_block(program_->shader, *target_, in, x, y, mask);
     return;
   }
@@ -16,10 +21,10 @@ void BlockBatch::add(const Interpolants& in, int x, int y, uint32_t mask) {
     held.winner[held.count] = &in;
     held.mask[held.count++] = mask;  // at most 16: the masks are disjoint and not empty
     slot.covered |= mask;
-    if (slot.covered == 0xffffu) shade(slot);  // complete: nothing more can join
+    if (slot.covered == 0xffffu) shade(index);  // complete: nothing more can join
     return;
   }
-  if (held.count != 0) shade(slot);
+  if (holds(index)) shade(index);
   slot.x = x;
   slot.y = y;
   slot.covered = mask;
@@ -27,15 +32,17 @@ void BlockBatch::add(const Interpolants& in, int x, int y, uint32_t mask) {
   held.winner[0] = &in;
   held.mask[0] = mask;
   held.count = 1;
+  held_[index >> 6] |= uint64_t(1) << (index & 63);
 }
 
 void BlockBatch::flush() {
-  for (Slot& slot : slots_) {
-    if (slot.block.count != 0) shade(slot);
+  for (int word = 0; word < kSide * kSide / 64; ++word) {
+    while (held_[word] != 0) shade(word * 64 + __builtin_ctzll(held_[word]));
   }
 }
 
-void BlockBatch::shade(Slot& slot) {
+void BlockBatch::shade(int index) {
+  Slot& slot = slots_[index];
   const MixedBlock& held = slot.block;
   if (held.count == 1) {
     program_->shade_block(program_->shader, *target_, *held.winner[0], slot.x, slot.y,
@@ -44,6 +51,7 @@ void BlockBatch::shade(Slot& slot) {
     program_->shade_mixed(program_->shader, *target_, held, slot.x, slot.y);
   }
   slot.block.count = 0;
+  held_[index >> 6] &= ~(uint64_t(1) << (index & 63));
 }
 
 }  // namespace softrast::detail

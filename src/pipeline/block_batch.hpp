@@ -51,13 +51,17 @@ class BlockBatch {
     MixedBlock block;      // count 0: empty
   };
   static constexpr int kSide = kTileSize / kBlockSize;  // a power of two
-  Slot& slot_of(int x, int y) {
-    return slots_[((x >> 2) & (kSide - 1)) | ((y >> 2) & (kSide - 1)) * kSide];
+  static int slot_index(int x, int y) {
+    return ((x >> 2) & (kSide - 1)) | ((y >> 2) & (kSide - 1)) * kSide;
   }
-  void shade(Slot& slot);
+  bool holds(int slot) const { return (held_[slot >> 6] >> (slot & 63)) & 1u; }
+  void shade(int slot);
 
   const FragmentProgram* program_ = nullptr;
   const ShadeTarget* target_ = nullptr;
+  // Which slots hold a block (count != 0): a whole block checks this, not its slot's 200 bytes,
+  // and flush visits only these.
+  uint64_t held_[kSide * kSide / 64] = {};
   Slot slots_[kSide * kSide];
 };
 
