@@ -275,6 +275,57 @@ TEST(SimdFma, FusedWhereTheLevelHasFma) {
   EXPECT_GT(differ, 1000);  // the operands do tell the two apart
 }
 
+// simd::normalize against glm::normalize at one level: how many lanes differ in any bit.
+template <int N>
+int normalize_mismatches(const std::vector<glm::vec3>& vs);
+template <int N>
+int normalize_mismatches_impl(const std::vector<glm::vec3>& vs) {
+  int mismatches = 0;
+  for (size_t first = 0; first + simd::kLanes <= vs.size(); first += simd::kLanes) {
+    alignas(64) float x[simd::kLanes], y[simd::kLanes], z[simd::kLanes];
+    for (int i = 0; i < simd::kLanes; ++i) {
+      x[i] = vs[first + i].x;
+      y[i] = vs[first + i].y;
+      z[i] = vs[first + i].z;
+    }
+    simd::Vec3<N> n = simd::normalize(
+        simd::Vec3<N>{simd::Float<N>::load(x), simd::Float<N>::load(y), simd::Float<N>::load(z)});
+    for (int i = 0; i < simd::kLanes; ++i) {
+      glm::vec3 want = glm::normalize(vs[first + i]);
+      mismatches += n.x.lane(i) != want.x || n.y.lane(i) != want.y || n.z.lane(i) != want.z;
+    }
+  }
+  return mismatches;
+}
+template <>
+int normalize_mismatches<4>(const std::vector<glm::vec3>& vs) {
+  return normalize_mismatches_impl<4>(vs);
+}
+template <>
+[[gnu::target("avx2,fma")]] int normalize_mismatches<8>(const std::vector<glm::vec3>& vs) {
+  return normalize_mismatches_impl<8>(vs);
+}
+template <>
+[[gnu::target("avx512f,avx512bw,avx512dq,avx512vl")]] int normalize_mismatches<16>(
+    const std::vector<glm::vec3>& vs) {
+  return normalize_mismatches_impl<16>(vs);
+}
+
+// simd::normalize stays glm's at every level, although simd::dot fuses where it can.
+TEST(SimdFma, NormalizeEqualsGlmAtEveryLevel) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::vector<glm::vec3> vs;
+  for (int i = 0; i < 4096; ++i) vs.push_back({unit(rng), unit(rng), unit(rng) * 1.0e3f});
+  EXPECT_EQ(normalize_mismatches<4>(vs), 0);
+  if (cpu_simd_level() >= SimdLevel::kAvx2) {
+    EXPECT_EQ(normalize_mismatches<8>(vs), 0);
+  }
+  if (cpu_simd_level() >= SimdLevel::kAvx512) {
+    EXPECT_EQ(normalize_mismatches<16>(vs), 0);
+  }
+}
+
 TEST(SimdSampler, MatchesScalarSamplingBitForBitAtEveryLevel) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> near_range(-3.0f, 3.0f), far_range(-1.0e6f, 1.0e6f);

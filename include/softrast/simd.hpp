@@ -717,14 +717,17 @@ SOFTRAST_SIMD_INLINE Vec3<N> splat3(const V3& v) {
   return {Float<N>(v.x), Float<N>(v.y), Float<N>(v.z)};
 }
 
+// a.x * b.x + a.y * b.y + a.z * b.z, the last two multiply-adds fused where the level has FMA
+// (simd::fma): may differ from glm::dot in the last bit there.
 template <int N>
 SOFTRAST_SIMD_INLINE Float<N> dot(const Vec3<N>& a, const Vec3<N>& b) {
   return fma(a.z, b.z, fma(a.y, b.y, a.x * b.x));
 }
-// v / |v| as glm::normalize computes it: v * (1 / sqrt(dot(v, v))).
+// v / |v| exactly as glm::normalize computes it, at every level: v * (1 / sqrt(dot(v, v))), the
+// dot product's sums rounded one by one.
 template <int N>
 SOFTRAST_SIMD_INLINE Vec3<N> normalize(const Vec3<N>& v) {
-  Float<N> inv = Float<N>(1.0f) / sqrt(dot(v, v));
+  Float<N> inv = Float<N>(1.0f) / sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
   return v * inv;
 }
 // v / |v| through rsqrt: within a few units in the last place of normalize, without the divider
