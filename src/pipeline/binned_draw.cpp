@@ -68,7 +68,8 @@ struct DrawCache {
   WindowVertices vertices;
   std::vector<Chunk> chunks;
   std::vector<std::unique_ptr<DeferredScratch>> scratch;  // per tile worker
-  std::vector<std::pair<uint32_t, uint32_t>> tile_order;   // (records, tile), busiest first
+  // (~bit width of the tile's record count, tile): the busiest class first, in tile order
+  std::vector<std::pair<uint32_t, uint32_t>> tile_order;
 };
 
 DrawCache& draw_cache() {

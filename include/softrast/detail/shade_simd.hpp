@@ -428,11 +428,14 @@ struct MixedPair {
   }
   SOFTRAST_SIMD_INLINE F x_ref() const { return pick(first.x_ref, second.x_ref); }
   SOFTRAST_SIMD_INLINE F y_ref() const { return pick(first.y_ref, second.y_ref); }
+  static float coefficient(const Plane& p, int j) {
+    return j == 0 ? p.a0 : j == 1 ? p.dadx : p.dady;
+  }
   SOFTRAST_SIMD_INLINE F inv_w(int j) const {
-    return pick((&first.inv_w.a0)[j], (&second.inv_w.a0)[j]);
+    return pick(coefficient(first.inv_w, j), coefficient(second.inv_w, j));
   }
   SOFTRAST_SIMD_INLINE F var(int i, int j) const {
-    return pick((&first.var[i].a0)[j], (&second.var[i].a0)[j]);
+    return pick(coefficient(first.var[i], j), coefficient(second.var[i], j));
   }
 };
 
