@@ -115,18 +115,35 @@ SOFTRAST_SIMD_INLINE simd::Float<N> eval_plane(const Plane& p, const simd::Float
   // The scalar eval_plane's operation order, so that both give the same bits.
   return simd::Float<N>(p.a0) + simd::Float<N>(p.dadx) * dx + simd::Float<N>(p.dady) * dy;
 }
-// Half a register's floats, and as many doubles (one register), at SSE and AVX2.
+// Half a register's floats, and as many doubles (one register), at SSE and AVX2; split and join
+// move between a register (Fn) and its two halves.
 template <std::size_t kBytes>
 struct HalfLanes;
 template <>
 struct HalfLanes<16> {
+  typedef float Fn __attribute__((vector_size(16)));
   typedef float F __attribute__((vector_size(8)));
   typedef double D __attribute__((vector_size(16)));
+  SOFTRAST_SIMD_INLINE static void split(const Fn& x, F& low, F& high) {
+    low = __builtin_shufflevector(x, x, 0, 1);
+    high = __builtin_shufflevector(x, x, 2, 3);
+  }
+  SOFTRAST_SIMD_INLINE static void join(const F& low, const F& high, Fn& out) {
+    out = __builtin_shufflevector(low, high, 0, 1, 2, 3);
+  }
 };
 template <>
 struct HalfLanes<32> {
+  typedef float Fn __attribute__((vector_size(32)));
   typedef float F __attribute__((vector_size(16)));
   typedef double D __attribute__((vector_size(32)));
+  SOFTRAST_SIMD_INLINE static void split(const Fn& x, F& low, F& high) {
+    low = __builtin_shufflevector(x, x, 0, 1, 2, 3);
+    high = __builtin_shufflevector(x, x, 4, 5, 6, 7);
+  }
+  SOFTRAST_SIMD_INLINE static void join(const F& low, const F& high, Fn& out) {
+    out = __builtin_shufflevector(low, high, 0, 1, 2, 3, 4, 5, 6, 7);
+  }
 };
 // (A named function, not a lambda: see pack_channel.)
 template <class H, class DH>
@@ -155,25 +172,14 @@ SOFTRAST_SIMD_INLINE simd::Float<N> eval_plane(const DepthPlane& p, const simd::
       z.p[k] = __builtin_convertvector((a0 + dadx * x) + dady * y, Fn);
     }
   } else {
-    using H = typename HalfLanes<sizeof(Fn)>::F;
-    using DH = typename HalfLanes<sizeof(Fn)>::D;
+    using Half = HalfLanes<sizeof(Fn)>;
     for (int k = 0; k < simd::Float<N>::kParts; ++k) {
-      const Fn x = dx.p[k], y = dy.p[k];
-      H low, high;
-      if constexpr (kHalf == 4) {
-        half_plane<H, DH>(p, __builtin_shufflevector(x, x, 0, 1, 2, 3),
-                          __builtin_shufflevector(y, y, 0, 1, 2, 3), low);
-        half_plane<H, DH>(p, __builtin_shufflevector(x, x, 4, 5, 6, 7),
-                          __builtin_shufflevector(y, y, 4, 5, 6, 7), high);
-        z.p[k] = __builtin_shufflevector(low, high, 0, 1, 2, 3, 4, 5, 6, 7);
-      } else {
-        static_assert(kHalf == 2);
-        half_plane<H, DH>(p, __builtin_shufflevector(x, x, 0, 1),
-                          __builtin_shufflevector(y, y, 0, 1), low);
-        half_plane<H, DH>(p, __builtin_shufflevector(x, x, 2, 3),
-                          __builtin_shufflevector(y, y, 2, 3), high);
-        z.p[k] = __builtin_shufflevector(low, high, 0, 1, 2, 3);
-      }
+      typename Half::F x_low, x_high, y_low, y_high, low, high;
+      Half::split(dx.p[k], x_low, x_high);
+      Half::split(dy.p[k], y_low, y_high);
+      half_plane<typename Half::F, typename Half::D>(p, x_low, y_low, low);
+      half_plane<typename Half::F, typename Half::D>(p, x_high, y_high, high);
+      Half::join(low, high, z.p[k]);
     }
   }
   return z;
