@@ -137,6 +137,18 @@ TEST(TileKernel, ResolveComputesTheFragmentStagesDepth) {
       if (i % 10 == 0) p.z.a0 = std::numeric_limits<float>::quiet_NaN();
       if (i % 10 == 1) p.z.dadx = 1e30f;
       if (i % 10 == 2) p.z = {0.5f, 0.0f, 0.0f};  // ties with the stored 0.5 below
+      // Planes of constant depth take the resolve's shortcut (z = float(a0) everywhere); planes
+      // flat in one direction only must not, nor a0 = 0 (there the sum's zero sign depends on the
+      // gradients' and dx's signs). (Not a0 = -0: the kernels broadcast a coefficient by adding
+      // it to a vector of +0, which makes -0 +0, so the wide stages store +0 where the scalar
+      // eval_plane stores -0; both compare equal in every depth test.)
+      if (i % 10 == 3) p.z.dadx = 0.0;
+      if (i % 10 == 4) p.z.dady = 0.0;
+      if (i % 10 == 5) {
+        const double a0[] = {0.0, 0.25, -0.5, 1.5, 0.7071067811865476};
+        const double zero[] = {0.0, -0.0};
+        p.z = {a0[(i / 10) % 5], zero[(i / 50) % 2], zero[(i / 100) % 2]};
+      }
       int x = 4 * int(rng() % 4000), y = 4 * int(rng() % 4000);
       uint32_t mask = rng() & 0xffffu;
       bool less_equal = i % 2 == 0;
