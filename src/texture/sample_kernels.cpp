@@ -170,6 +170,15 @@ SOFTRAST_AVX512_FN void store16(const Texels16& c, SampleLanes& io) {
   _mm512_store_ps(io.out[3], c.a);
 }
 
+// bilinear16_texels's row_shift for levels of widths `w` (a power of two when pow2): log2 of the
+// width where every lane's level has the same one (usually: a block's lanes share their levels),
+// else -1. (A named function, not a lambda: see shade_simd.hpp's pack_channel.)
+SOFTRAST_AVX512_FN int row_shift16(const simd::Int<16>& w, bool pow2) {
+  const int32_t first = w.lane(0);
+  return pow2 && simd::bits(w == simd::Int<16>(first)) == 0xffffu ? __builtin_ctz(unsigned(first))
+                                                                  : -1;
+}
+
 // sample_inline, both forms, for bilinear and trilinear samplers without sRGB decode.
 SOFTRAST_AVX512_FN void filtered16(const Texture& texture, const Sampler& s, SampleLanes& io,
                                    bool derivatives) {
@@ -194,12 +203,12 @@ SOFTRAST_AVX512_FN void filtered16(const Texture& texture, const Sampler& s, Sam
   I w0, h0, o0;
   level_lanes<16>(texture, l0, w0, h0, o0);
   Texels16 c = bilinear16(texture, s, u, v, __m512i(w0.p[0]), __m512i(h0.p[0]), __m512i(o0.p[0]),
-                          pow2_u, pow2_v, -1);
+                          pow2_u, pow2_v, row_shift16(w0, pow2_u));
   if (simd::any(t > F(0.0f))) {  // else every lane's second weight is 0 (sample_inline)
     I w1, h1, o1;
     level_lanes<16>(texture, l1, w1, h1, o1);
     Texels16 c1 = bilinear16(texture, s, u, v, __m512i(w1.p[0]), __m512i(h1.p[0]), __m512i(o1.p[0]),
-                             pow2_u, pow2_v, -1);
+                             pow2_u, pow2_v, row_shift16(w1, pow2_u));
     c = lerp16(c, c1, __m512(t.p[0]));
   }
   store16(c, io);

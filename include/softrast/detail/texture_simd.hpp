@@ -388,6 +388,16 @@ SOFTRAST_SIMD_INLINE void level_lanes(const Texture& t, const simd::Int<N>& l, s
   static_assert(sizeof(MipLevel) == 16 && offsetof(MipLevel, height) == 4 &&
                 offsetof(MipLevel, offset) == 8);
   using I = simd::Int<N>;
+  // Usually a block's lanes are all at one level: that level's entry is read once and broadcast,
+  // the same values as the three gathers below (a third of the gathers of a trilinear sample).
+  const int32_t first = l.lane(0);
+  if (simd::bits(l == I(first)) == 0xffffu) {
+    const MipLevel& level = t.level(first);
+    w = I(level.width);
+    h = I(level.height);
+    offset = I(int32_t(level.offset));
+    return;
+  }
   const auto* table = reinterpret_cast<const int32_t*>(&t.level(0));
   I at = l * I(4);
   w = simd::gather<N>(table, at);
