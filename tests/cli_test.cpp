@@ -29,6 +29,7 @@
 
 #include "softrast/framebuffer.hpp"
 #include "softrast/image.hpp"
+#include "softrast/simd_level.hpp"
 
 namespace softrast {
 namespace {
@@ -120,11 +121,12 @@ class CliTest : public testing::Test {
   }
 
   // Runs `softrast ARGS` (ARGS as typed in a shell) in the work folder.
-  CliRun run(const std::string& args) const {
+  // `env`: variable assignments for the program's environment ("NAME=value ...").
+  CliRun run(const std::string& args, const std::string& env = "") const {
     fs::path out = root_ / "logs" / "stdout", err = root_ / "logs" / "stderr";
-    std::string command = "cd " + quote(work_dir().string()) + " && " + quote(SOFTRAST_CLI_PATH) +
-                          " " + args + " >" + quote(out.string()) + " 2>" + quote(err.string()) +
-                          " </dev/null";
+    std::string command = "cd " + quote(work_dir().string()) + " && " + env + " " +
+                          quote(SOFTRAST_CLI_PATH) + " " + args + " >" + quote(out.string()) +
+                          " 2>" + quote(err.string()) + " </dev/null";
     int status = std::system(command.c_str());
     CliRun result;
     if (status != -1 && WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
@@ -428,6 +430,24 @@ void expect_json_line(const std::string& out, const std::string& scene, int tria
         std::string("\"mtris_per_s\":"), std::string("\"mpix_per_s\":")}) {
     EXPECT_NE(out.find(field), std::string::npos) << field << " missing in " << out;
   }
+}
+
+// The line says how texels were gathered: the mode SOFTRAST_GATHER fixes, or the one timed
+// fastest ("loads" at SSE2, which has no gather instruction).
+TEST_F(CliTest, FramesReportsTheGatherMode) {
+  for (const char* mode : {"instruction", "loads"}) {
+    CliRun r =
+        run("--frames 3 --size 64x48 --shader texture", std::string("SOFTRAST_GATHER=") + mode);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    // (A CPU without AVX2 runs SSE, which always loads.)
+    const bool has_gathers = cpu_simd_level() >= SimdLevel::kAvx2;
+    const std::string want = has_gathers ? mode : "loads";
+    EXPECT_NE(r.out.find("\"gathers\":\"" + want + "\""), std::string::npos) << r.out;
+  }
+  CliRun sse2 = run("--frames 3 --size 64x48", "SOFTRAST_SIMD=sse2");
+  ASSERT_EQ(sse2.exit_code, 0) << sse2.err;
+  EXPECT_NE(sse2.out.find("\"simd\":\"sse2\",\"gathers\":\"loads\""), std::string::npos)
+      << sse2.out;
 }
 
 TEST_F(CliTest, FramesPrintsOneJsonLineAndWritesOnlyWithOutput) {

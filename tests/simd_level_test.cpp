@@ -22,6 +22,15 @@ class SimdLevelGuard {
   ~SimdLevelGuard() { set_simd_level(SimdLevel::kAvx512); }
 };
 
+// Restores the gather mode a test changed (the one chosen for this CPU).
+class GatherModeGuard {
+ public:
+  ~GatherModeGuard() { set_gather_mode(saved_); }
+
+ private:
+  GatherMode saved_ = gather_mode(cpu_simd_level());
+};
+
 std::vector<SimdLevel> levels_of_this_cpu() {
   std::vector<SimdLevel> levels;
   for (int i = 0; i <= int(cpu_simd_level()); ++i) levels.push_back(SimdLevel(i));
@@ -327,6 +336,7 @@ TEST(SimdFma, NormalizeEqualsGlmAtEveryLevel) {
 }
 
 TEST(SimdSampler, MatchesScalarSamplingBitForBitAtEveryLevel) {
+  GatherModeGuard guard;
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> near_range(-3.0f, 3.0f), far_range(-1.0e6f, 1.0e6f);
   std::vector<glm::vec2> uvs;
@@ -348,12 +358,133 @@ TEST(SimdSampler, MatchesScalarSamplingBitForBitAtEveryLevel) {
                        std::to_string(int(filter)) + " wrap " + std::to_string(int(wrap)) +
                        (srgb ? " srgb" : ""));
           check_sampler_at_native_width<4>(texture, sampler, uvs);
-          if (cpu_simd_level() >= SimdLevel::kAvx2) {
-            check_sampler_at_native_width<8>(texture, sampler, uvs);
+          // Both ways of gathering texels: the instruction and one load per lane.
+          for (GatherMode mode : {GatherMode::kInstruction, GatherMode::kLoads}) {
+            SCOPED_TRACE(gather_mode_name(mode));
+            set_gather_mode(mode);
+            if (cpu_simd_level() >= SimdLevel::kAvx2) {
+              check_sampler_at_native_width<8>(texture, sampler, uvs);
+            }
+            if (cpu_simd_level() >= SimdLevel::kAvx512) {
+              check_sampler_at_native_width<16>(texture, sampler, uvs);
+            }
           }
-          if (cpu_simd_level() >= SimdLevel::kAvx512) {
-            check_sampler_at_native_width<16>(texture, sampler, uvs);
-          }
+        }
+      }
+    }
+  }
+}
+
+// The two forms of each gather (simd::isa): the instruction and one load per lane, against the
+// elements they should read, at indices all over a table (the first and last elements among
+// them), inside functions compiled for the width's level as the shaders are.
+// r[i] = table[index[i]] by the form asked for, and the pairs lo[i] = table[index[i]], hi[i] =
+// table[index[i] + 1] through gather_pair in that mode. Inlined into the functions below.
+template <int N>
+SOFTRAST_SIMD_INLINE void gather_by(const int32_t* table, const typename simd::Native<N>::I& index,
+                                    bool loads, typename simd::Native<N>::I& r,
+                                    typename simd::Native<N>::I& lo,
+                                    typename simd::Native<N>::I& hi) {
+  if (loads) {
+    simd::isa::gather_loads(table, index, r);
+  } else {
+    simd::isa::gather_instruction(table, index, r);
+  }
+  set_gather_mode(loads ? GatherMode::kLoads : GatherMode::kInstruction);
+  simd::isa::gather_pair(table, index, lo, hi);
+}
+template <int N>
+struct GatherForms {
+  using V = typename simd::Native<N>::I;
+  static void run(const int32_t* table, const V& index, bool loads, V& r, V& lo, V& hi);
+};
+template <>
+[[gnu::target("avx2")]] void GatherForms<8>::run(const int32_t* table, const V& index, bool loads,
+                                                 V& r, V& lo, V& hi) {
+  gather_by<8>(table, index, loads, r, lo, hi);
+}
+template <>
+[[gnu::target("avx512f,avx512bw,avx512dq,avx512vl")]] void GatherForms<16>::run(
+    const int32_t* table, const V& index, bool loads, V& r, V& lo, V& hi) {
+  gather_by<16>(table, index, loads, r, lo, hi);
+}
+
+template <int N>
+void expect_gathers_read_their_elements() {
+  using V = typename simd::Native<N>::I;
+  constexpr int kSize = 1000;
+  std::vector<int32_t> table(kSize);
+  for (int i = 0; i < kSize; ++i) table[size_t(i)] = int32_t(i * 7919 + 13);
+  std::mt19937 rng(N);
+  std::uniform_int_distribution<int> pick(0, kSize - 2);  // a pair's second element exists
+  for (int round = 0; round < 200; ++round) {
+    V index;
+    for (int i = 0; i < N; ++i) index[i] = pick(rng);
+    if (round == 0) index[0] = 0, index[N - 1] = kSize - 2;
+    for (bool loads : {false, true}) {
+      V r, lo, hi;
+      GatherForms<N>::run(table.data(), index, loads, r, lo, hi);
+      for (int i = 0; i < N; ++i) {
+        ASSERT_EQ(r[i], table[size_t(index[i])])
+            << (loads ? "loads" : "instruction") << " lane " << i;
+        ASSERT_EQ(lo[i], table[size_t(index[i])])
+            << (loads ? "loads" : "instruction") << " lane " << i;
+        ASSERT_EQ(hi[i], table[size_t(index[i]) + 1])
+            << (loads ? "loads" : "instruction") << " lane " << i;
+      }
+    }
+  }
+}
+
+TEST(SimdGather, InstructionAndLoadsReadTheSameElements) {
+  GatherModeGuard guard;
+  if (cpu_simd_level() < SimdLevel::kAvx2) GTEST_SKIP() << "no AVX2: no gather instruction";
+  expect_gathers_read_their_elements<8>();
+  if (cpu_simd_level() >= SimdLevel::kAvx512) expect_gathers_read_their_elements<16>();
+}
+
+TEST(SimdGather, ModeIsChosenOverriddenAndReported) {
+  GatherModeGuard guard;
+  // Below AVX2 there is no instruction: always loads.
+  EXPECT_EQ(gather_mode(SimdLevel::kSse2), GatherMode::kLoads);
+  EXPECT_EQ(gather_mode(SimdLevel::kSse4), GatherMode::kLoads);
+  for (GatherMode mode : {GatherMode::kInstruction, GatherMode::kLoads}) {
+    set_gather_mode(mode);
+    EXPECT_EQ(gather_mode(SimdLevel::kAvx2), mode);
+    EXPECT_EQ(gather_mode(SimdLevel::kAvx512), mode);
+  }
+  EXPECT_STREQ(gather_mode_name(GatherMode::kInstruction), "instruction");
+  EXPECT_STREQ(gather_mode_name(GatherMode::kLoads), "loads");
+}
+
+// Every shader that samples, at every level, with either form of gather: the same image bit for
+// bit (trilinear too, which also gathers from the level table).
+TEST(SimdGather, TexturedRendersAreTheSameWithEitherForm) {
+  SimdLevelGuard level_guard;
+  GatherModeGuard guard;
+  // A power-of-two texture (the AVX-512 bilinear fast path), another size (the general path), and
+  // an sRGB one read through the decode table.
+  const auto pow2 = std::make_shared<Texture>(noise_texture(64, 64, 5));
+  const auto odd = std::make_shared<Texture>(noise_texture(37, 19, 6));
+  const auto srgb = std::make_shared<Texture>(noise_texture(32, 32, 7, true));
+  for (SimdLevel level : levels_of_this_cpu()) {
+    if (level < SimdLevel::kAvx2) continue;
+    for (ShaderKind kind : {ShaderKind::kTexture, ShaderKind::kPhong}) {
+      for (Filter filter : {Filter::kBilinear, Filter::kTrilinear, Filter::kNearest}) {
+        for (const auto& texture : {pow2, odd, srgb}) {
+          RenderOptions options;
+          options.shader = kind;
+          options.texture = texture;
+          options.srgb = texture == srgb;
+          options.sampler = Sampler{filter, Wrap::kRepeat, Wrap::kClampToEdge, texture == srgb};
+          set_gather_mode(GatherMode::kInstruction);
+          Rendered instruction = render_demo_at(level, options);
+          set_gather_mode(GatherMode::kLoads);
+          Rendered loads = render_demo_at(level, options);
+          EXPECT_EQ(instruction.image.rgba, loads.image.rgba)
+              << simd_level_name(level) << " " << shader_kind_name(kind) << " filter "
+              << int(filter) << " texture " << texture->width() << "x" << texture->height();
+          EXPECT_EQ(instruction.depth, loads.depth);
         }
       }
     }

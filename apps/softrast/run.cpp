@@ -120,6 +120,7 @@ std::string json_line(const Job& job, const FrameStats& s) {
          ",\"mtris_per_s\":" + format("%.3f", triangles / seconds / 1e6) +
          ",\"mpix_per_s\":" + format("%.3f", pixels / seconds / 1e6) +
          ",\"simd\":" + json_string(simd_level_name(simd_level())) +
+         ",\"gathers\":" + json_string(gather_mode_name(gather_mode(simd_level()))) +
          ",\"peak_rss_mib\":" + format("%.1f", peak_rss_mib()) + "}";
 }
 

@@ -332,6 +332,17 @@ SOFTRAST_SIMD_INLINE Float<N> abs(const Float<N>& a) {
 }
 
 // ---- Operations the vector extensions lack: one helper per instruction set. ----
+
+// Whether the gathers of N lanes (8: AVX2, 16: AVX-512) are one load per lane instead of the
+// gather instruction: the same values either way, and the faster on this CPU (gather_mode() in
+// softrast/simd_level.hpp, settled before the first draw). Index 0 for 8 lanes, 1 for 16.
+extern bool g_loads_for_gathers[2];
+template <int N>
+SOFTRAST_SIMD_INLINE bool loads_for_gathers() {
+  static_assert(N == 8 || N == 16);
+  return g_loads_for_gathers[N == 16];
+}
+
 namespace isa {
 
 // The comparison predicate must be a constant after inlining (it always is: an operator's).
@@ -470,15 +481,130 @@ inline void gather(const int32_t* base, const Native<4>::I& index, Native<4>::I&
     r[i] = v;
   }
 }
-[[gnu::target("avx2")]] inline void gather(const int32_t* base, const Native<8>::I& index,
-                                           Native<8>::I& r) {
+// The gathers of AVX2 and AVX-512 come in two forms that give the same values: the instruction
+// (`*_instruction`) and one scalar load per lane (`*_loads`), which the CPU runs faster where its
+// microcode slows the instruction down (gather_mode()). `at` holds the lanes' indices.
+// Keeps the indices in memory: read back by scalar loads, they cost the load ports, where GCC
+// would otherwise take each out of the vector by an extract on the shuffle port, which the
+// shaders' own shuffles need.
+template <size_t Lanes>
+SOFTRAST_SIMD_INLINE void through_memory(int32_t (&at)[Lanes]) {
+  asm("" : "+m"(at));
+}
+// The 16 indices stored as two 256-bit halves: a 512-bit store does not forward to the scalar
+// loads that read its upper half, which then wait for the store to reach the cache (measured:
+// twice the time of the loads themselves).
+[[gnu::target("avx512f")]] inline void store_halves(int32_t (&at)[16], const Native<16>::I& index) {
+  using V = Native<8>::IU;
+  *reinterpret_cast<V*>(at) = __builtin_shufflevector(index, index, 0, 1, 2, 3, 4, 5, 6, 7);
+  *reinterpret_cast<V*>(at + 8) =
+      __builtin_shufflevector(index, index, 8, 9, 10, 11, 12, 13, 14, 15);
+  through_memory(at);
+}
+[[gnu::target("avx2")]] inline __m128i load_lanes4(const int32_t* base, const int32_t* at) {
+  auto lane = [base](int32_t i) {
+    int32_t v;
+    std::memcpy(&v, base + i, sizeof v);  // the base may be a byte array
+    return _mm_cvtsi32_si128(v);
+  };
+  return _mm_unpacklo_epi64(_mm_unpacklo_epi32(lane(at[0]), lane(at[1])),
+                            _mm_unpacklo_epi32(lane(at[2]), lane(at[3])));
+}
+// Two lanes' pairs: base[at[0]], base[at[0] + 1], base[at[1]], base[at[1] + 1].
+[[gnu::target("avx2")]] inline __m128i load_pairs2(const int32_t* base, const int32_t* at) {
+  return _mm_unpacklo_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + at[0])),
+                            _mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + at[1])));
+}
+[[gnu::target("avx2")]] inline __m256i join(__m128i low, __m128i high) {
+  return _mm256_inserti128_si256(_mm256_castsi128_si256(low), high, 1);
+}
+[[gnu::target("avx512f")]] inline __m512i join(__m256i low, __m256i high) {
+  // (A vector shuffle, not the cast intrinsic, whose undefined upper half GCC 12 reports.)
+  using V = Native<8>::I;
+  return __m512i(__builtin_shufflevector(V(low), V(high), 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12,
+                                         13, 14, 15));
+}
+
+[[gnu::target("avx2")]] inline void gather_instruction(const int32_t* base,
+                                                       const Native<8>::I& index, Native<8>::I& r) {
   r = Native<8>::I(_mm256_mask_i32gather_epi32(_mm256_setzero_si256(), base, __m256i(index),
                                                _mm256_set1_epi32(-1), 4));
 }
-[[gnu::target("avx512f")]] inline void gather(const int32_t* base, const Native<16>::I& index,
-                                              Native<16>::I& r) {
+[[gnu::target("avx2")]] inline void gather_loads(const int32_t* base, const Native<8>::I& index,
+                                                 Native<8>::I& r) {
+  alignas(32) int32_t at[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(at), __m256i(index));
+  through_memory(at);
+  r = Native<8>::I(join(load_lanes4(base, at), load_lanes4(base, at + 4)));
+}
+[[gnu::target("avx512f")]] inline void gather_instruction(const int32_t* base,
+                                                          const Native<16>::I& index,
+                                                          Native<16>::I& r) {
   r = Native<16>::I(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), __mmask16(0xffff),
                                                 __m512i(index), base, 4));
+}
+[[gnu::target("avx512f")]] inline void gather_loads(const int32_t* base, const Native<16>::I& index,
+                                                    Native<16>::I& r) {
+  alignas(64) int32_t at[16];
+  store_halves(at, index);
+  r = Native<16>::I(join(join(load_lanes4(base, at), load_lanes4(base, at + 4)),
+                         join(load_lanes4(base, at + 8), load_lanes4(base, at + 12))));
+}
+[[gnu::target("avx2")]] inline void gather(const int32_t* base, const Native<8>::I& index,
+                                           Native<8>::I& r) {
+  if (loads_for_gathers<8>()) {
+    gather_loads(base, index, r);
+  } else {
+    gather_instruction(base, index, r);
+  }
+}
+[[gnu::target("avx512f")]] inline void gather(const int32_t* base, const Native<16>::I& index,
+                                              Native<16>::I& r) {
+  if (loads_for_gathers<16>()) {
+    gather_loads(base, index, r);
+  } else {
+    gather_instruction(base, index, r);
+  }
+}
+
+// The 64-bit pairs base[index[i]], base[index[i] + 1] of every lane, in lane order: a holds
+// lanes 0 to N/2 - 1, c the rest (gather_pair below sorts them into lo and hi).
+[[gnu::target("avx2")]] inline void pairs_instruction(const int32_t* base,
+                                                      const Native<8>::I& index, __m256i& a,
+                                                      __m256i& c) {
+  const auto* pairs = reinterpret_cast<const long long*>(base);
+  __m256i i = __m256i(index);
+  a = _mm256_i32gather_epi64(pairs, _mm256_castsi256_si128(i), 4);
+  c = _mm256_i32gather_epi64(pairs, _mm256_extracti128_si256(i, 1), 4);
+}
+[[gnu::target("avx2")]] inline void pairs_loads(const int32_t* base, const Native<8>::I& index,
+                                                __m256i& a, __m256i& c) {
+  alignas(32) int32_t at[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(at), __m256i(index));
+  through_memory(at);
+  a = join(load_pairs2(base, at), load_pairs2(base, at + 2));
+  c = join(load_pairs2(base, at + 4), load_pairs2(base, at + 6));
+}
+[[gnu::target("avx512f")]] inline void pairs_instruction(const int32_t* base,
+                                                         const Native<16>::I& index, __m512i& a,
+                                                         __m512i& c) {
+  // The masked form with a zero source, and the index's halves by a vector shuffle: GCC 12's
+  // header leaves the unmasked forms' sources uninitialised (a -Wmaybe-uninitialized warning
+  // wherever this is inlined; GCC bug 105593).
+  const __m512i zero = _mm512_setzero_si512();
+  const Native<8>::I low = __builtin_shufflevector(index, index, 0, 1, 2, 3, 4, 5, 6, 7);
+  const Native<8>::I high = __builtin_shufflevector(index, index, 8, 9, 10, 11, 12, 13, 14, 15);
+  a = _mm512_mask_i32gather_epi64(zero, 0xff, __m256i(low), base, 4);
+  c = _mm512_mask_i32gather_epi64(zero, 0xff, __m256i(high), base, 4);
+}
+[[gnu::target("avx512f")]] inline void pairs_loads(const int32_t* base, const Native<16>::I& index,
+                                                   __m512i& a, __m512i& c) {
+  alignas(64) int32_t at[16];
+  store_halves(at, index);
+  a = join(join(load_pairs2(base, at), load_pairs2(base, at + 2)),
+           join(load_pairs2(base, at + 4), load_pairs2(base, at + 6)));
+  c = join(join(load_pairs2(base, at + 8), load_pairs2(base, at + 10)),
+           join(load_pairs2(base, at + 12), load_pairs2(base, at + 14)));
 }
 
 // r[i] = table[index[i]] for a table of 16 floats, indices in [0, 16): a permute, no memory
@@ -534,11 +660,14 @@ inline void gather_pair(const int32_t* base, const Native<4>::I& index, Native<4
 }
 [[gnu::target("avx2")]] inline void gather_pair(const int32_t* base, const Native<8>::I& index,
                                                 Native<8>::I& lo, Native<8>::I& hi) {
-  const auto* pairs = reinterpret_cast<const long long*>(base);
-  __m256i i = __m256i(index);
   // a = l0 h0 l1 h1 | l2 h2 l3 h3, c = l4 h4 l5 h5 | l6 h6 l7 h7 (32-bit elements)
-  __m256 a = _mm256_castsi256_ps(_mm256_i32gather_epi64(pairs, _mm256_castsi256_si128(i), 4));
-  __m256 c = _mm256_castsi256_ps(_mm256_i32gather_epi64(pairs, _mm256_extracti128_si256(i, 1), 4));
+  __m256i ai, ci;
+  if (loads_for_gathers<8>()) {
+    pairs_loads(base, index, ai, ci);
+  } else {
+    pairs_instruction(base, index, ai, ci);
+  }
+  __m256 a = _mm256_castsi256_ps(ai), c = _mm256_castsi256_ps(ci);
   // Even elements (l0 l1 l4 l5 | l2 l3 l6 l7), odd ones likewise, then the 64-bit pieces in order.
   __m256 l = _mm256_shuffle_ps(a, c, 0x88), h = _mm256_shuffle_ps(a, c, 0xdd);
   lo = Native<8>::I(_mm256_permute4x64_epi64(_mm256_castps_si256(l), 0xd8));
@@ -546,14 +675,13 @@ inline void gather_pair(const int32_t* base, const Native<4>::I& index, Native<4
 }
 [[gnu::target("avx512f")]] inline void gather_pair(const int32_t* base, const Native<16>::I& index,
                                                    Native<16>::I& lo, Native<16>::I& hi) {
-  // The masked form with a zero source, and the index's halves by a vector shuffle: the same
-  // instructions, and GCC 12's header does not leave the unmasked forms' sources uninitialised (a
-  // -Wmaybe-uninitialized warning wherever this is inlined; GCC bug 105593).
-  const __m512i zero = _mm512_setzero_si512();
-  const Native<8>::I low = __builtin_shufflevector(index, index, 0, 1, 2, 3, 4, 5, 6, 7);
-  const Native<8>::I high = __builtin_shufflevector(index, index, 8, 9, 10, 11, 12, 13, 14, 15);
-  __m512i a = _mm512_mask_i32gather_epi64(zero, 0xff, __m256i(low), base, 4);
-  __m512i c = _mm512_mask_i32gather_epi64(zero, 0xff, __m256i(high), base, 4);
+  // a = lanes 0 to 7's pairs, c = lanes 8 to 15's (each pair two 32-bit elements, l then h)
+  __m512i a, c;
+  if (loads_for_gathers<16>()) {
+    pairs_loads(base, index, a, c);
+  } else {
+    pairs_instruction(base, index, a, c);
+  }
   const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
   const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
   lo = Native<16>::I(_mm512_permutex2var_epi32(a, even, c));

@@ -23,6 +23,25 @@ SimdLevel simd_level();
 // Not to be called while a draw is running on another thread.
 void set_simd_level(SimdLevel cap);
 
+// How the AVX2 and AVX-512 levels read memory at an address per lane (texels, above all): with
+// the CPU's gather instruction, or with one scalar load per lane. Both read the same values, so
+// images do not depend on it; the speed does, and which is faster depends on the CPU (Intel's
+// microcode against Gather Data Sampling, "Downfall", 2023, made the instruction several times
+// slower on the cores from Skylake to Tiger Lake). By default the first draw times both on a
+// small table, per vector width, and keeps the faster one (the instruction unless loads are
+// clearly faster). SOFTRAST_GATHER=instruction|loads or set_gather_mode() fixes the choice. SSE2
+// and SSE4.2, which have no gather instruction, always load per lane.
+enum class GatherMode { kInstruction, kLoads };
+
+// The mode the given level's gathers use.
+GatherMode gather_mode(SimdLevel level);
+
+// Fixes the mode of every level for draws started after this call. Not to be called while a
+// draw is running on another thread.
+void set_gather_mode(GatherMode mode);
+
+const char* gather_mode_name(GatherMode mode);
+
 const char* simd_level_name(SimdLevel level);
 std::optional<SimdLevel> parse_simd_level(std::string_view name);
 

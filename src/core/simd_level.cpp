@@ -1,9 +1,17 @@
-// core/simd_level.cpp: CPU feature detection and the process-wide SIMD level cap.
+// core/simd_level.cpp: CPU feature detection, the process-wide SIMD level cap, and the choice
+// between the gather instruction and per-lane loads.
 #include "softrast/simd_level.hpp"
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <cstdint>
 #include <cstdlib>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "softrast/simd.hpp"
 
 namespace softrast {
 namespace {
@@ -35,7 +43,102 @@ std::atomic<int>& cap() {
   return value;
 }
 
+// ---- Gathers: the instruction or one load per lane, whichever this CPU runs faster. ----
+
+// A table of 16 KiB (it stays in the L1 cache, so the times compare the instructions, not
+// memory), and the rounds of one timing: 256 gathers of 8 or 16 pairs, microseconds in all.
+constexpr int kTableSize = 4096;
+constexpr int kRounds = 256;
+
+// The register type of the pairs' halves at each width.
+template <int N>
+struct PairRegister;
+template <>
+struct PairRegister<8> {
+  using T = __m256i;
+};
+template <>
+struct PairRegister<16> {
+  using T = __m512i;
+};
+
+// Reads kRounds * N pairs from `table` with the instruction or with loads (the two forms
+// gather_pair chooses between) and returns the nanoseconds taken; `sink` keeps the reads.
+// Inlined into a function compiled for the width's level (below).
+template <int N>
+SOFTRAST_SIMD_INLINE double time_pairs(const int32_t* table, bool loads, uint32_t& sink) {
+  using V = typename simd::Native<N>::I;
+  V index, acc = {};
+  for (int i = 0; i < N; ++i) index[i] = i * (kTableSize / N) + i;  // spread over the table
+  auto start = std::chrono::steady_clock::now();
+  for (int r = 0; r < kRounds; ++r) {
+    typename PairRegister<N>::T a, c;
+    if (loads) {
+      simd::isa::pairs_loads(table, index, a, c);
+    } else {
+      simd::isa::pairs_instruction(table, index, a, c);
+    }
+    acc ^= V(a) ^ V(c);
+    index = (index + 129) & (kTableSize - 1);
+  }
+  auto end = std::chrono::steady_clock::now();
+  for (int i = 0; i < N; ++i) sink += uint32_t(acc[i]);
+  return std::chrono::duration<double, std::nano>(end - start).count();
+}
+[[gnu::target("avx2")]] double time_pairs8(const int32_t* table, bool loads, uint32_t& sink) {
+  return time_pairs<8>(table, loads, sink);
+}
+[[gnu::target("avx512f")]] double time_pairs16(const int32_t* table, bool loads, uint32_t& sink) {
+  return time_pairs<16>(table, loads, sink);
+}
+
+// Whether loads beat the instruction: the fastest of seven timings of each, taken in turn (so
+// that a change of clock speed or a busy moment falls on both), loads chosen only when at least
+// a fifth faster.
+template <class Time>
+bool loads_are_faster(Time time) {
+  std::vector<int32_t> table(kTableSize + 1);  // + 1: the last lane's pair may start at the end
+  for (int i = 0; i <= kTableSize; ++i) table[size_t(i)] = i * 2654435761u;
+  uint32_t sink = 0;
+  double instruction = 1e300, loads = 1e300;
+  for (int trial = 0; trial < 7; ++trial) {
+    instruction = std::min(instruction, time(table.data(), false, sink));
+    loads = std::min(loads, time(table.data(), true, sink));
+  }
+  volatile uint32_t keep = sink;  // the reads must happen
+  (void)keep;
+  return loads < 0.8 * instruction;
+}
+
+std::optional<GatherMode> gather_mode_from_env() {
+  const char* env = std::getenv("SOFTRAST_GATHER");
+  if (!env) return std::nullopt;
+  for (GatherMode mode : {GatherMode::kInstruction, GatherMode::kLoads}) {
+    if (std::string_view(env) == gather_mode_name(mode)) return mode;
+  }
+  return std::nullopt;
+}
+
+// Settles simd::g_loads_for_gathers once, before the first draw reads it.
+void settle_gathers() {
+  static const bool settled = [] {
+    const SimdLevel cpu = cpu_simd_level();
+    if (std::optional<GatherMode> mode = gather_mode_from_env()) {
+      simd::g_loads_for_gathers[0] = simd::g_loads_for_gathers[1] = *mode == GatherMode::kLoads;
+      return true;
+    }
+    if (cpu >= SimdLevel::kAvx2) simd::g_loads_for_gathers[0] = loads_are_faster(time_pairs8);
+    if (cpu >= SimdLevel::kAvx512) simd::g_loads_for_gathers[1] = loads_are_faster(time_pairs16);
+    return true;
+  }();
+  (void)settled;
+}
+
 }  // namespace
+
+namespace simd {
+bool g_loads_for_gathers[2] = {false, false};
+}  // namespace simd
 
 SimdLevel cpu_simd_level() {
   static const SimdLevel level = detect();
@@ -43,7 +146,24 @@ SimdLevel cpu_simd_level() {
 }
 
 SimdLevel simd_level() {
+  settle_gathers();
   return SimdLevel(std::min(int(cpu_simd_level()), cap().load(std::memory_order_relaxed)));
+}
+
+GatherMode gather_mode(SimdLevel level) {
+  settle_gathers();
+  if (level < SimdLevel::kAvx2) return GatherMode::kLoads;
+  return simd::g_loads_for_gathers[level == SimdLevel::kAvx512] ? GatherMode::kLoads
+                                                                : GatherMode::kInstruction;
+}
+
+void set_gather_mode(GatherMode mode) {
+  settle_gathers();
+  simd::g_loads_for_gathers[0] = simd::g_loads_for_gathers[1] = mode == GatherMode::kLoads;
+}
+
+const char* gather_mode_name(GatherMode mode) {
+  return mode == GatherMode::kLoads ? "loads" : "instruction";
 }
 
 void set_simd_level(SimdLevel level) {

@@ -235,18 +235,15 @@ SOFTRAST_AVX512_SAMPLER void gather_bilinear16(
     const int32_t* texels, const simd::Native<16>::I& row0, const simd::Native<16>::I& row1,
     const simd::Native<16>::I& i0, const simd::Native<16>::I& i1, simd::Native<16>::I& b0,
     simd::Native<16>::I& b1, simd::Native<16>::I& t0, simd::Native<16>::I& t1) {
-  using V = simd::Native<16>::I;
   if (_mm512_cmpneq_epi32_mask(__m512i(i1), __m512i(i0 + 1)) == 0) {
     simd::isa::gather_pair(texels, row0 + i0, b0, b1);
     simd::isa::gather_pair(texels, row1 + i0, t0, t1);
     return;
   }
-  const __m512i zero = _mm512_setzero_si512();
-  const __mmask16 all = 0xffff;
-  b0 = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row0 + i0), texels, 4));
-  b1 = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row0 + i1), texels, 4));
-  t0 = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row1 + i0), texels, 4));
-  t1 = V(_mm512_mask_i32gather_epi32(zero, all, __m512i(row1 + i1), texels, 4));
+  simd::isa::gather(texels, row0 + i0, b0);
+  simd::isa::gather(texels, row0 + i1, b1);
+  simd::isa::gather(texels, row1 + i0, t0);
+  simd::isa::gather(texels, row1 + i1, t1);
 }
 
 // The four texels (bilinear_texels) and the weights' fractions of 16 lanes where
