@@ -484,6 +484,7 @@ inline void gather(const int32_t* base, const Native<4>::I& index, Native<4>::I&
 // The gathers of AVX2 and AVX-512 come in two forms that give the same values: the instruction
 // (`*_instruction`) and one scalar load per lane (`*_loads`), which the CPU runs faster where its
 // microcode slows the instruction down (gather_mode()). `at` holds the lanes' indices.
+
 // Keeps the indices in memory: read back by scalar loads, they cost the load ports, where GCC
 // would otherwise take each out of the vector by an extract on the shuffle port, which the
 // shaders' own shuffles need.
