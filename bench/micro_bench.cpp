@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -135,7 +136,9 @@ void BM_Coverage(benchmark::State& state) {
 BENCHMARK(BM_Coverage)->Arg(2)->Arg(10)->Arg(100);
 
 // The fragment stage: a full-screen pair of triangles through each built-in shader, at each
-// SIMD level the CPU has (depth test off so that every frame shades every pixel).
+// SIMD level the CPU has (depth test off so that every frame shades every pixel); the texturing
+// shaders at AVX2 and AVX-512 with each form of gather too (third argument: GatherMode, or -1 for
+// the one chosen on this CPU).
 void BM_Shade(benchmark::State& state) {
   ShaderKind kind = ShaderKind(state.range(0));
   SimdLevel level = SimdLevel(state.range(1));
@@ -144,6 +147,9 @@ void BM_Shade(benchmark::State& state) {
     return;
   }
   set_simd_level(level);
+  const GatherMode chosen = gather_mode(cpu_simd_level());
+  if (state.range(2) >= 0) set_gather_mode(GatherMode(state.range(2)));
+  state.SetLabel(std::string("gathers: ") + gather_mode_name(gather_mode(level)));
   Mesh quad;
   quad.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
   quad.normals.assign(4, glm::vec3(0, 0, 1));
@@ -164,11 +170,19 @@ void BM_Shade(benchmark::State& state) {
   for (auto _ : state) render_mesh(fb, quad, camera, options);
   state.SetItemsProcessed(int64_t(state.iterations()) * 512 * 512);
   set_simd_level(SimdLevel::kAvx512);
+  set_gather_mode(chosen);
 }
 void shade_args(benchmark::internal::Benchmark* b) {
   for (ShaderKind k :
        {ShaderKind::kFlat, ShaderKind::kGouraud, ShaderKind::kTexture, ShaderKind::kPhong}) {
-    for (int level = 0; level < 4; ++level) b->Args({int(k), level});
+    for (int level = 0; level < 4; ++level) b->Args({int(k), level, -1});
+  }
+  for (ShaderKind k : {ShaderKind::kTexture, ShaderKind::kPhong}) {
+    for (int level : {int(SimdLevel::kAvx2), int(SimdLevel::kAvx512)}) {
+      for (GatherMode mode : {GatherMode::kInstruction, GatherMode::kLoads}) {
+        b->Args({int(k), level, int(mode)});
+      }
+    }
   }
 }
 BENCHMARK(BM_Shade)->Apply(shade_args);
