@@ -335,20 +335,6 @@ SOFTRAST_SIMD_INLINE void bilinear_texels(const Texture& t, const Sampler& s,
   t1 = simd::gather<N>(texels, offset + j1 * w + i1);
 }
 
-// bilinear_texels of the base level (bilinear_rgba8_applies' case, at AVX2: inlined into the
-// shaders as bilinear_texels16 is at AVX-512).
-template <int N>
-SOFTRAST_SIMD_INLINE void base_bilinear_texels(const Texture& t, const Sampler& s,
-                                               const simd::Vec2<N>& uv, simd::Int<N>& b0,
-                                               simd::Int<N>& b1, simd::Int<N>& t0,
-                                               simd::Int<N>& t1, simd::Float<N>& fx,
-                                               simd::Float<N>& fy) {
-  using I = simd::Int<N>;
-  const int w = t.width(), h = t.height();
-  bilinear_texels<N>(t, s, uv, I(w), I(h), I(0), (w & (w - 1)) == 0, (h & (h - 1)) == 0, b0, b1,
-                     t0, t1, fx, fy);
-}
-
 // One level per lane (size w x h, first texel `offset`), nearest or bilinear: the arithmetic of
 // Texture::sample_nearest / sample_bilinear in the same order.
 template <int N>
@@ -530,13 +516,6 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler&
       detail::avx512::bilinear_texels16(texture, s, uv, b0, b1, t0, t1, fx, fy);
       return detail::filter_rgba8<N>(b0, b1, t0, t1, fx, fy);
     }
-  } else if constexpr (N == 8) {
-    if (detail::avx512::bilinear_rgba8_applies(texture, s)) {
-      simd::Int<N> b0, b1, t0, t1;
-      F fx, fy;
-      detail::base_bilinear_texels<N>(texture, s, uv, b0, b1, t0, t1, fx, fy);
-      return detail::filter_rgba8<N>(b0, b1, t0, t1, fx, fy);
-    }
   }
   detail::SampleLanes io;
   uv.x.store(io.in[0]);
@@ -557,13 +536,6 @@ SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8(const Texture& texture, const Sam
       simd::Int<N> b0, b1, t0, t1;
       simd::Float<N> fx, fy;
       detail::avx512::bilinear_texels16(texture, s, uv, b0, b1, t0, t1, fx, fy);
-      return detail::filter_rgba8_packed<N>(b0, b1, t0, t1, fx, fy);
-    }
-  } else if constexpr (N == 8) {
-    if (detail::avx512::bilinear_rgba8_applies(texture, s)) {
-      simd::Int<N> b0, b1, t0, t1;
-      simd::Float<N> fx, fy;
-      detail::base_bilinear_texels<N>(texture, s, uv, b0, b1, t0, t1, fx, fy);
       return detail::filter_rgba8_packed<N>(b0, b1, t0, t1, fx, fy);
     }
   }
