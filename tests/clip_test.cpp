@@ -20,6 +20,7 @@
 
 #include "geometry/clip.hpp"
 #include "geometry/viewport.hpp"
+#include "softrast/camera.hpp"
 #include "test_util.hpp"
 
 namespace softrast {
@@ -491,6 +492,51 @@ TEST(ClipTriangleDeathTest, PolygonNeverOutgrowsItsBuffer) {
 TEST(ClipTriangleDeathTest, CornerTriangleThroughDrawDoesNotCrash) {
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   EXPECT_EXIT(draw_corner_triangle_and_exit(), testing::ExitedWithCode(0), "");
+}
+
+// A camera in units of 1e30 (eye, target, near and far all scaled) projects every point where the
+// same camera in units of 1 projects it scaled the same: lengths, lookAt and the projection are
+// computed in double, where the squares of such coordinates (1e60, past float's 3.4e38) and the
+// projection's 2 far near do not overflow. Perspective and orthographic.
+TEST(CameraScale, HugeUnitsProjectLikeUnitOnes) {
+  for (bool ortho : {false, true}) {
+    for (float scale : {1.0e20f, 1.0e30f}) {
+      Camera unit, huge;
+      unit.eye = {1.0f, 2.0f, 5.0f};
+      unit.target = {0.5f, -0.25f, -1.0f};
+      unit.near_plane = 0.5f;
+      unit.far_plane = 40.0f;
+      unit.orthographic = ortho;
+      unit.ortho_left = -3.0f, unit.ortho_right = 2.0f, unit.ortho_bottom = -1.5f;
+      unit.ortho_top = 2.5f;
+      huge = unit;
+      huge.eye *= scale, huge.target *= scale;
+      huge.near_plane *= scale, huge.far_plane *= scale;
+      huge.ortho_left *= scale, huge.ortho_right *= scale, huge.ortho_bottom *= scale;
+      huge.ortho_top *= scale;
+      ASSERT_TRUE(unit.validate().ok());
+      ASSERT_TRUE(huge.validate().ok()) << huge.validate().message();
+      glm::mat4 a = unit.view_projection(1.5f), b = huge.view_projection(1.5f);
+      for (glm::vec3 p : {glm::vec3(0.0f), glm::vec3(1.0f, -2.0f, 3.0f),
+                          glm::vec3(-4.0f, 1.0f, -8.0f), glm::vec3(0.5f, 0.5f, -20.0f)}) {
+        glm::vec4 ca = a * glm::vec4(p, 1.0f), cb = b * glm::vec4(p * scale, 1.0f);
+        ASSERT_TRUE(std::isfinite(cb.x) && std::isfinite(cb.y) && std::isfinite(cb.z) &&
+                    std::isfinite(cb.w));
+        glm::vec3 na = glm::vec3(ca) / ca.w, nb = glm::vec3(cb) / cb.w;  // normalised device
+        for (int k = 0; k < 3; ++k) {
+          EXPECT_NEAR(nb[k], na[k], 1e-4f * std::max(1.0f, std::abs(na[k])))
+              << "ortho " << ortho << " scale " << scale << " point " << p.x << "," << p.y << ","
+              << p.z << " axis " << k;
+        }
+      }
+    }
+  }
+  // Up parallel to the view direction is still refused at that scale.
+  Camera bad;
+  bad.eye = {0.0f, 3.0e30f, 0.0f};
+  bad.target = {0.0f, 0.0f, 0.0f};
+  bad.near_plane = 1.0e29f, bad.far_plane = 1.0e31f;
+  EXPECT_FALSE(bad.validate().ok());
 }
 
 }  // namespace

@@ -106,12 +106,12 @@ glm::vec3 center_of(const Mesh& mesh) {
 }
 
 float radius_of(const Mesh& mesh, glm::vec3 center) {
-  float r2 = 0.0f;
+  double r2 = 0.0;  // in double: squares of coordinates past 1.8e19 overflow float
   for (const glm::vec3& p : mesh.positions) {
-    glm::vec3 d = p - center;
+    glm::dvec3 d = glm::dvec3(p) - glm::dvec3(center);
     r2 = std::max(r2, glm::dot(d, d));
   }
-  float r = std::sqrt(r2);
+  float r = float(std::sqrt(r2));
   return r > 0.0f && std::isfinite(r) ? r : 1.0f;
 }
 
@@ -194,7 +194,8 @@ void set_depth_range(Camera& camera, float lo, float hi, const CameraFlags& flag
 
 // The distances every vertex spans in front of the camera.
 std::pair<float, float> vertex_depths(const Camera& camera, const Mesh& mesh) {
-  glm::vec3 forward = glm::normalize(camera.target - camera.eye);
+  // Normalised in double: float squares overflow for a model in units past 1.8e19.
+  glm::vec3 forward = glm::vec3(glm::normalize(glm::dvec3(camera.target) - glm::dvec3(camera.eye)));
   float lo = std::numeric_limits<float>::max(), hi = -lo;
   for (const glm::vec3& p : mesh.positions) {
     float d = glm::dot(p - camera.eye, forward);
@@ -268,7 +269,7 @@ Camera frame_model(const Bounds& bounds, const CameraFlags& flags, float aspect)
   glm::vec3 direction =
       bounds.flat_in_y ? glm::normalize(glm::vec3(0.0f, 1.0f, 1.0f)) : glm::vec3(0.0f, 0.0f, 1.0f);
   camera.eye = flags.eye.value_or(camera.target + direction * distance);
-  float to_center = glm::length(camera.eye - bounds.center);
+  float to_center = float(glm::length(glm::dvec3(camera.eye) - glm::dvec3(bounds.center)));
   set_depth_range(camera, to_center - bounds.radius, to_center + bounds.radius, flags);
   return camera;
 }

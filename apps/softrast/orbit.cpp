@@ -23,7 +23,7 @@ Orbit::Orbit(const Camera& camera, const Bounds& bounds, bool fixed_depth)
     : base_(camera), bounds_(bounds), fixed_depth_(fixed_depth) {
   glm::vec3 offset = camera.eye - camera.target;
   state_.target = camera.target;
-  state_.distance = std::max(glm::length(offset), 1.0e-6f);
+  state_.distance = std::max(float(glm::length(glm::dvec3(offset))), 1.0e-6f);  // no overflow
   state_.yaw = std::atan2(offset.x, offset.z);
   state_.pitch = std::clamp(std::asin(std::clamp(offset.y / state_.distance, -1.0f, 1.0f)),
                             -kMaxPitch, kMaxPitch);
@@ -39,7 +39,8 @@ void Orbit::rotate(float dx_pixels, float dy_pixels) {
 // The point under the cursor at the target's depth moves with the cursor.
 void Orbit::pan(float dx_pixels, float dy_pixels, int height) {
   Camera c = camera();
-  glm::vec3 forward = glm::normalize(c.target - c.eye);
+  // In double: squares of coordinates past 1.8e19 overflow float.
+  glm::vec3 forward = glm::vec3(glm::normalize(glm::dvec3(c.target) - glm::dvec3(c.eye)));
   glm::vec3 right = glm::normalize(glm::cross(forward, c.up));
   glm::vec3 up = glm::cross(right, forward);
   float view_height = c.orthographic
