@@ -296,53 +296,67 @@ TEST(CliFraming, AnglesUpAxesAndZoom) {
   EXPECT_NEAR(half.right - half.left + 1, (full.right - full.left + 1) * 0.5, 3.0);
 }
 
-// A model in units of 1e30 (past 1.8e19 a float's square overflows) is framed and drawn as the
-// same model in units of 1: the camera's lengths, view and projection are computed in double.
-// Flat shading, so that only the coverage is compared; it was an error ("up is parallel to the
-// view direction") and then an empty image before.
-TEST(CliFraming, HugeCoordinatesAreFramedLikeSmallOnes) {
+// A model in units of 1e30 or 1e-9 is framed and drawn as the same model in units of 1. At 1e30
+// a float's square overflows (past 1.8e19): the camera's lengths, view and projection fall back to
+// double; it was an error ("up is parallel to the view direction"), then an empty image. At 1e-9
+// the clipper's smallest w (1e-6) and the framing's absolute floors (depths of 1e-6, a far plane
+// of at least 1e-3 with the near plane a thousandth of it) removed or misplaced everything. Flat
+// shading, so that only the coverage is compared.
+TEST(CliFraming, HugeAndTinyUnitsAreFramedLikeUnitOnes) {
   CliFolder folder;
-  std::string small = long_part_obj(), huge;
-  std::istringstream lines(small);
-  for (std::string line; std::getline(lines, line);) {
-    if (line.rfind("v ", 0) == 0) {
-      std::istringstream v(line.substr(2));
-      float x, y, z;
-      v >> x >> y >> z;
-      std::ostringstream scaled;
-      scaled << "v " << x * 1e30f << " " << y * 1e30f << " " << z * 1e30f;
-      line = scaled.str();
-    }
-    huge += line + "\n";
-  }
-  folder.write("small.obj", small);
-  folder.write("huge.obj", huge);
-  // Framed automatically from two sides, and an orthographic box (which scales with the model)
-  // with the eye and the depth range automatic.
-  const std::pair<std::string, std::string> kFlags[] = {
-      {"--view front", "--view front"},
-      {"--view iso", "--view iso"},
-      {"--view top --ortho -12,12,-9,9", "--view top --ortho -12e30,12e30,-9e30,9e30"}};
-  for (const auto& [small_flags, huge_flags] : kFlags) {
-    const std::string common = " --shader flat --background 0,0,0 --size 160x90 ";
-    Image a = folder.render("small.obj" + common + small_flags, "small.png");
-    Image b = folder.render("huge.obj" + common + huge_flags, "huge.png");
-    ASSERT_FALSE(a.rgba.empty());
-    ASSERT_FALSE(b.rgba.empty());
-    Extent ea = model_extent(a), eb = model_extent(b);
-    ASSERT_LE(eb.left, eb.right) << huge_flags << ": no model pixel";
-    EXPECT_NEAR(eb.left, ea.left, 1) << huge_flags;
-    EXPECT_NEAR(eb.right, ea.right, 1) << huge_flags;
-    EXPECT_NEAR(eb.top, ea.top, 1) << huge_flags;
-    EXPECT_NEAR(eb.bottom, ea.bottom, 1) << huge_flags;
-    // Pixel by pixel: at most a few pixels along the edges differ in coverage.
-    int differ = 0;
-    for (int y = 0; y < a.height; ++y) {
-      for (int x = 0; x < a.width; ++x) {
-        differ += is_background(a, x, y, {0, 0, 0}) != is_background(b, x, y, {0, 0, 0});
+  const std::string unit = long_part_obj();
+  folder.write("unit.obj", unit);
+  for (float scale : {1e30f, 1e-9f}) {
+    std::string scaled_obj;
+    std::istringstream lines(unit);
+    for (std::string line; std::getline(lines, line);) {
+      if (line.rfind("v ", 0) == 0) {
+        std::istringstream v(line.substr(2));
+        float x, y, z;
+        v >> x >> y >> z;
+        std::ostringstream scaled;
+        scaled.precision(9);
+        scaled << "v " << x * scale << " " << y * scale << " " << z * scale;
+        line = scaled.str();
       }
+      scaled_obj += line + "\n";
     }
-    EXPECT_LE(differ, 8) << huge_flags;
+    folder.write("scaled.obj", scaled_obj);
+    std::ostringstream label_text;
+    label_text << "scale " << scale;
+    const std::string label = label_text.str();
+    std::ostringstream box;  // the orthographic box scales with the model
+    box.precision(9);
+    box << "--view top --ortho " << -12 * scale << "," << 12 * scale << "," << -9 * scale << ","
+        << 9 * scale;
+    // Framed automatically from two sides, and in an orthographic box with the eye and the depth
+    // range automatic.
+    const std::pair<std::string, std::string> kFlags[] = {
+        {"--view front", "--view front"},
+        {"--view iso", "--view iso"},
+        {"--view top --ortho -12,12,-9,9", box.str()}};
+    for (const auto& [unit_flags, scaled_flags] : kFlags) {
+      const std::string what = label + " " + scaled_flags;
+      const std::string common = " --shader flat --background 0,0,0 --size 160x90 ";
+      Image a = folder.render("unit.obj" + common + unit_flags, "unit.png");
+      Image b = folder.render("scaled.obj" + common + scaled_flags, "scaled.png");
+      ASSERT_FALSE(a.rgba.empty());
+      ASSERT_FALSE(b.rgba.empty());
+      Extent ea = model_extent(a), eb = model_extent(b);
+      ASSERT_LE(eb.left, eb.right) << what << ": no model pixel";
+      EXPECT_NEAR(eb.left, ea.left, 1) << what;
+      EXPECT_NEAR(eb.right, ea.right, 1) << what;
+      EXPECT_NEAR(eb.top, ea.top, 1) << what;
+      EXPECT_NEAR(eb.bottom, ea.bottom, 1) << what;
+      // Pixel by pixel: at most a few pixels along the edges differ in coverage.
+      int differ = 0;
+      for (int y = 0; y < a.height; ++y) {
+        for (int x = 0; x < a.width; ++x) {
+          differ += is_background(a, x, y, {0, 0, 0}) != is_background(b, x, y, {0, 0, 0});
+        }
+      }
+      EXPECT_LE(differ, 8) << what;
+    }
   }
 }
 

@@ -539,5 +539,72 @@ TEST(CameraScale, HugeUnitsProjectLikeUnitOnes) {
   EXPECT_FALSE(bad.validate().ok());
 }
 
+// A scene in tiny units: the same clip-space primitives with every coordinate scaled by 2^-95
+// (w near 5e-29) draw the same image bit for bit as at scale 1, triangles, lines and points, with
+// varyings of 1e12 (colour = varying / 1e12). Setup scales each primitive's 1/w by a power of
+// two, which leaves the perspective-correct quotient exact; without it var / w overflows float
+// (1e12 * 2e28), and with the clipper's old smallest w of 1e-6 nothing was drawn at all.
+struct ScaledClipShader {
+  static constexpr int kVaryings = 3;
+  const glm::vec4* clip = nullptr;
+  const glm::vec3* varyings = nullptr;
+  float scale = 1.0f;
+  glm::vec4 vertex(uint32_t i, float* v) const {
+    v[0] = varyings[i].x, v[1] = varyings[i].y, v[2] = varyings[i].z;
+    return clip[i] * scale;
+  }
+  bool fragment(FragmentInput& in, glm::vec4& out) const {
+    out = {in.varyings[0] * 1.0e-12f, in.varyings[1] * 1.0e-12f, in.varyings[2] * 1.0e-12f, 1.0f};
+    return true;
+  }
+};
+
+TEST(ClipTinyW, PrimitivesInTinyUnitsDrawAsAtUnitScale) {
+  // A perspective-looking triangle (w from 1 to 3) and a fan quad; corners in clip space.
+  const std::vector<glm::vec4> clip = {{-0.9f, -0.8f, 0.2f, 1.0f},
+                                       {2.4f, -1.5f, 1.0f, 3.0f},
+                                       {0.1f, 1.6f, 0.5f, 2.0f},
+                                       {-1.2f, 1.0f, 0.1f, 1.5f},
+                                       {0.3f, -0.2f, 0.4f, 1.25f}};
+  const std::vector<glm::vec3> varyings = {{1.0e12f, 0.0f, 0.2e12f},
+                                           {0.0f, 1.0e12f, 0.5e12f},
+                                           {0.3e12f, 0.2e12f, 1.0e12f},
+                                           {0.8e12f, 0.8e12f, 0.0f},
+                                           {0.5e12f, 0.1e12f, 0.9e12f}};
+  struct Case {
+    Primitive primitive;
+    std::vector<uint32_t> indices;
+  };
+  const Case cases[] = {{Primitive::kTriangles, {0, 1, 2, 0, 2, 3}},
+                        {Primitive::kLines, {0, 1, 1, 2, 2, 3, 3, 0, 0, 4}},
+                        {Primitive::kPoints, {0, 1, 2, 3, 4}}};
+  for (const Case& c : cases) {
+    for (RasterAlgorithm raster : {RasterAlgorithm::kEdgeEquations, RasterAlgorithm::kScanline}) {
+      SCOPED_TRACE("primitive " + std::to_string(int(c.primitive)) + ", raster " +
+                   std::to_string(int(raster)));
+      RenderState state;
+      state.primitive = c.primitive;
+      state.raster = raster;
+      std::vector<uint32_t> images[2];
+      for (int k = 0; k < 2; ++k) {
+        Framebuffer fb(96, 64);
+        fb.clear_color({0.0f, 0.0f, 0.0f, 0.0f});
+        ScaledClipShader shader{clip.data(), varyings.data(), k == 0 ? 1.0f : 0x1p-95f};
+        draw(fb, state, shader, c.indices, uint32_t(clip.size()));
+        for (int y = 0; y < fb.height(); ++y) {
+          for (int x = 0; x < fb.width(); ++x) images[k].push_back(fb.color_at(x, y));
+        }
+      }
+      size_t drawn = 0, differ = 0;
+      for (size_t i = 0; i < images[0].size(); ++i) {
+        drawn += images[0][i] != 0;
+        differ += images[0][i] != images[1][i];
+      }
+      EXPECT_GT(drawn, c.primitive == Primitive::kTriangles ? 1000u : 4u);
+      EXPECT_EQ(differ, 0u) << "of " << drawn << " drawn pixels";
+    }
+  }
+}
+
 }  // namespace
 }  // namespace softrast

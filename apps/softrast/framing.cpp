@@ -130,10 +130,15 @@ std::pair<float, float> fit_axis(const Mesh& mesh, glm::vec3 axis, glm::vec3 bac
 // For the axis that does not limit: the camera position that centres the model's projected
 // extent at distance c_z (bisection; the sum of the two extreme slopes falls as c moves right).
 float centre_axis(const Mesh& mesh, glm::vec3 axis, glm::vec3 back, float cz, float c) {
+  // Depths are kept above a millionth of the largest (relative, so that a model in tiny units is
+  // centred as the same model in units of 1).
+  float deepest = 0.0f;
+  for (const glm::vec3& p : mesh.positions) deepest = std::max(deepest, cz - glm::dot(p, back));
+  const float min_depth = std::max(1.0e-6f * deepest, std::numeric_limits<float>::min());
   auto imbalance = [&](float cx) {
     float hi = -std::numeric_limits<float>::max(), lo = std::numeric_limits<float>::max();
     for (const glm::vec3& p : mesh.positions) {
-      float depth = std::max(cz - glm::dot(p, back), 1.0e-6f);
+      float depth = std::max(cz - glm::dot(p, back), min_depth);
       float slope = (glm::dot(p, axis) - cx) / depth;
       hi = std::max(hi, slope), lo = std::min(lo, slope);
     }
@@ -178,8 +183,11 @@ glm::vec3 fit_eye(const Mesh& mesh, const ViewFrame& view, float kx, float ky,
 // direction), with a margin, from the flags where given; an automatic value that contradicts a
 // given one gives way to it.
 void set_depth_range(Camera& camera, float lo, float hi, const CameraFlags& flags) {
-  float margin = kDepthMargin * std::max(hi - lo, 1.0e-3f * std::abs(hi)) + 1.0e-6f;
-  float far_plane = std::max(hi + margin, 1.0e-3f);
+  // Relative to the scene's own size and distance, so that a model in tiny units (1e-9) gets
+  // planes around it, not a fixed floor in front of it.
+  float margin = kDepthMargin * std::max(hi - lo, 1.0e-3f * std::abs(hi));
+  if (!(margin > 0.0f)) margin = 1.0e-6f;                        // a flat model through the eye
+  float far_plane = hi + margin > 0.0f ? hi + margin : 1.0e-3f;  // 1e-3: nothing in front
   float near_plane = std::max(lo - margin, far_plane * kMinNearRatio);
   if (camera.orthographic) near_plane = lo - margin;  // anything in front of the box
   if (flags.far_plane && !flags.near_plane && near_plane >= *flags.far_plane) {
@@ -239,7 +247,7 @@ Camera frame_model(const Mesh& mesh, const CameraFlags& flags, float aspect) {
     camera.eye = fit_eye(mesh, view, kx, ky, flags.target);
     if (!flags.target) {  // look at the model's centre depth, along the fitted axis
       float distance = glm::dot(camera.eye - center, view.back);
-      camera.target = camera.eye - view.back * std::max(distance, 1.0e-6f);
+      camera.target = camera.eye - view.back * (distance > 0.0f ? distance : 1.0e-6f);
     }
   }
   auto [lo, hi] = vertex_depths(camera, mesh);

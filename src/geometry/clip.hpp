@@ -22,8 +22,11 @@ struct ClipVolume {
 };
 
 // Smallest w that reaches the divide. The near plane already keeps w >= near for perspective
-// projections; this plane protects arbitrary user matrices from w <= 0.
-inline constexpr float kMinClipW = 1.0e-6f;
+// projections; this plane protects arbitrary user matrices from w <= 0. Small enough for a scene
+// in tiny units (a camera 1e-9 from a model has w near 1e-9: 1e-6 clipped it all away), large
+// enough that 1 / w stays a normal float; setup scales each triangle's 1/w by a power of two so
+// that its planes stay in range (setup.cpp).
+inline constexpr float kMinClipW = 1.0e-30f;
 inline constexpr int kNumClipPlanes = 7;
 // Sutherland-Hodgman adds at most one vertex per plane to a convex polygon, but rounding can make
 // the polygon slightly non-convex near plane corners, and then a pass can add more: a pass over n

@@ -57,6 +57,26 @@ Plane to_float(const DepthPlane& p) {
   return {float(p.a0), float(p.dadx), float(p.dady)};
 }
 
+// The 1/w of a primitive's vertices for its planes: as they are, unless the largest exceeds 2^20
+// (w under about 1e-6: a scene in tiny units); then all times the power of two that brings the
+// largest to [0.5, 1). Scaling by a power of two is exact, so the fragment stage's quotient
+// plane(var) / plane(1/w) is unchanged bit for bit, but var / w stays far from float's range (1/w
+// reaches 1e30 at the clipper's smallest w).
+[[gnu::cold, gnu::noinline]] void scale_tiny_w(double* inv_w, int count) {
+  double largest = *std::max_element(inv_w, inv_w + count);
+  int exponent = 0;
+  std::frexp(largest, &exponent);
+  for (int k = 0; k < count; ++k) inv_w[k] = std::ldexp(inv_w[k], -exponent);
+}
+template <int kCount>
+void scaled_inv_w(const float (&in)[kCount], double (&out)[kCount]) {
+  bool tiny = false;
+  for (int k = 0; k < kCount; ++k) out[k] = in[k], tiny |= in[k] > 0x1p20f;
+  if (tiny) [[unlikely]] {
+    scale_tiny_w(out, kCount);
+  }
+}
+
 PixelRect triangle_bounds(const int32_t vx[3], const int32_t vy[3]) {
   int64_t xmin = std::min({vx[0], vx[1], vx[2]}), xmax = std::max({vx[0], vx[1], vx[2]});
   int64_t ymin = std::min({vy[0], vy[1], vy[2]}), ymax = std::max({vy[0], vy[1], vy[2]});
@@ -112,12 +132,14 @@ void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area
   out.x_ref = float(to_pixels(v[0]->x));
   out.y_ref = float(to_pixels(v[0]->y));
   out.z = plane(v[0]->z, v[1]->z, v[2]->z);
-  out.inv_w = to_float(plane(v[0]->inv_w, v[1]->inv_w, v[2]->inv_w));
+  double iw[3];  // 1/w, times a power of two where w is tiny (scaled_inv_w)
+  scaled_inv_w({v[0]->inv_w, v[1]->inv_w, v[2]->inv_w}, iw);
+  const double w0 = iw[0], w1 = iw[1], w2 = iw[2];
+  out.inv_w = to_float(plane(w0, w1, w2));
   const float *a0 = v[0]->varyings, *a1 = v[1]->varyings, *a2 = v[2]->varyings;
   for (int i = 0; i < num_varyings; ++i) {
-    // float * float is exact in double.
-    out.var[i] = to_float(plane(double(a0[i]) * v[0]->inv_w, double(a1[i]) * v[1]->inv_w,
-                                double(a2[i]) * v[2]->inv_w));
+    // float * float (times a power of two) is exact in double.
+    out.var[i] = to_float(plane(double(a0[i]) * w0, double(a1[i]) * w1, double(a2[i]) * w2));
   }
   out.num_varyings = num_varyings;
 }
@@ -205,10 +227,12 @@ bool setup_line(const WindowVertex& v0, const WindowVertex& v1, int num_varyings
   in.x_ref = float(to_pixels(v0.x));
   in.y_ref = float(to_pixels(v0.y));
   in.z = line_plane(v0.z, v1.z);
-  in.inv_w = to_float(line_plane(v0.inv_w, v1.inv_w));
+  double iw[2];  // as setup_planes
+  scaled_inv_w({v0.inv_w, v1.inv_w}, iw);
+  const double w0 = iw[0], w1 = iw[1];
+  in.inv_w = to_float(line_plane(w0, w1));
   for (int i = 0; i < num_varyings; ++i) {
-    in.var[i] =
-        to_float(line_plane(double(v0.varyings[i]) * v0.inv_w, double(v1.varyings[i]) * v1.inv_w));
+    in.var[i] = to_float(line_plane(double(v0.varyings[i]) * w0, double(v1.varyings[i]) * w1));
   }
   in.num_varyings = num_varyings;
   in.front_facing = true;
@@ -224,8 +248,10 @@ bool setup_point(const WindowVertex& v, int num_varyings, const PixelRect& sciss
   out.x_ref = float(to_pixels(v.x));
   out.y_ref = float(to_pixels(v.y));
   out.z.a0 = v.z;
-  out.inv_w.a0 = v.inv_w;
-  for (int i = 0; i < num_varyings; ++i) out.var[i].a0 = v.varyings[i] * v.inv_w;
+  double iw[1];  // as setup_planes
+  scaled_inv_w({v.inv_w}, iw);
+  out.inv_w.a0 = float(iw[0]);
+  for (int i = 0; i < num_varyings; ++i) out.var[i].a0 = float(double(v.varyings[i]) * iw[0]);
   out.num_varyings = num_varyings;
   out.front_facing = true;
   return true;
