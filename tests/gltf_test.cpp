@@ -116,6 +116,94 @@ TEST_F(GltfTest, NodeTransformsPlaceEveryVertex) {
   EXPECT_TRUE(found);
 }
 
+// Adds to accessor `accessor` a sparse block of `indices` (uint8, 5121; uint16, 5123; uint32,
+// 5125) and `values` (the accessor's element type, tightly packed), each in a bufferView of its
+// own.
+void add_sparse(GltfParts& g, int accessor, int index_type, const std::vector<uint32_t>& indices,
+                const std::string& values) {
+  std::string index_bytes;
+  for (uint32_t i : indices) {
+    int width = index_type == 5121 ? 1 : index_type == 5123 ? 2 : 4;
+    index_bytes.append(reinterpret_cast<const char*>(&i), size_t(width));  // little-endian
+  }
+  auto view_of = [&](const std::string& bytes) {
+    while (g.bin.size() % 4) g.bin += '\0';
+    int view = int(g.json["bufferViews"].size());
+    g.json["bufferViews"].push_back(
+        {{"buffer", 0}, {"byteOffset", g.bin.size()}, {"byteLength", bytes.size()}});
+    g.bin += bytes;
+    return view;
+  };
+  int index_view = view_of(index_bytes), value_view = view_of(values);
+  g.json["accessors"][size_t(accessor)]["sparse"] = {
+      {"count", indices.size()},
+      {"indices", {{"bufferView", index_view}, {"componentType", index_type}}},
+      {"values", {{"bufferView", value_view}}}};
+}
+
+void expect_same_mesh(const Mesh& a, const Mesh& b, const char* what) {
+  EXPECT_EQ(a.positions, b.positions) << what;
+  EXPECT_EQ(a.normals, b.normals) << what;
+  EXPECT_EQ(a.uvs, b.uvs) << what;
+  EXPECT_EQ(a.indices, b.indices) << what;
+}
+
+// Sparse accessors (glTF 2.0, 3.6.2.3): the elements their strictly increasing indices name take
+// their values, the others the bufferView's, or zeros where the accessor has no bufferView (also
+// without sparse). Each file is loaded beside the same scene with the values written directly
+// into its buffer: the meshes must be equal, element for element. Before, a sparse accessor
+// refused the whole file.
+TEST_F(GltfTest, SparseAccessorsAndAccessorsWithoutAViewReadAsWritten) {
+  const GltfParts cube = test::textured_cube(png_);
+  auto load = [&](const GltfParts& g, const char* name) {
+    Result<Mesh> mesh = load_model(write(name, test::as_gltf(g)));
+    EXPECT_TRUE(mesh.ok()) << name << ": " << mesh.status().message();
+    return mesh.ok() ? *mesh : Mesh();
+  };
+  auto floats_of = [](const GltfParts& g, int accessor) {
+    const nlohmann::json& a = g.json["accessors"][size_t(accessor)];
+    const nlohmann::json& v = g.json["bufferViews"][size_t(a["bufferView"].get<int>())];
+    return g.bin.substr(v["byteOffset"].get<size_t>(), v["byteLength"].get<size_t>());
+  };
+  // Positions (accessor 0): vertices 2, 7 and 23 moved, by uint8, uint16 and uint32 indices.
+  for (int index_type : {5121, 5123, 5125}) {
+    GltfParts sparse = cube, direct = cube;
+    std::vector<float> moved = {0.7f, -0.6f, 0.5f, 0.1f, 0.9f, -0.3f, -0.8f, 0.2f, 0.6f};
+    add_sparse(sparse, 0, index_type, {2, 7, 23}, test::float_bytes(moved));
+    std::string positions = floats_of(direct, 0);
+    const size_t offset = direct.json["bufferViews"][0]["byteOffset"].get<size_t>();
+    for (int k = 0; k < 3; ++k) {
+      size_t vertex = std::vector<size_t>{2, 7, 23}[size_t(k)];
+      std::memcpy(&direct.bin[offset + vertex * 12], &moved[size_t(3 * k)], 12);
+    }
+    ASSERT_EQ(positions.size(), 288u);
+    expect_same_mesh(load(sparse, "sparse.gltf"), load(direct, "direct.gltf"), "positions");
+  }
+  // Texture coordinates (accessor 2) with no bufferView: zeros, then all 24 given sparsely.
+  {
+    GltfParts zeros = cube, zeros_direct = cube;
+    zeros.json["accessors"][2].erase("bufferView");
+    const size_t offset = zeros_direct.json["bufferViews"][2]["byteOffset"].get<size_t>();
+    std::memset(&zeros_direct.bin[offset], 0, 24 * 8);
+    expect_same_mesh(load(zeros, "zeros.gltf"), load(zeros_direct, "zeros_direct.gltf"), "zeros");
+    GltfParts filled = cube;
+    std::string uvs = floats_of(cube, 2);
+    filled.json["accessors"][2].erase("bufferView");
+    std::vector<uint32_t> all(24);
+    for (uint32_t i = 0; i < 24; ++i) all[i] = i;
+    add_sparse(filled, 2, 5121, all, uvs);
+    expect_same_mesh(load(filled, "filled.gltf"), load(cube, "cube.gltf"), "filled");
+  }
+  // Indices (accessor 3, uint16): triangle 1's corners given sparsely as triangle 0's.
+  {
+    GltfParts sparse = cube, direct = cube;
+    add_sparse(sparse, 3, 5123, {3, 4, 5}, test::u16_bytes({0, 2, 3}));
+    uint16_t corners[3] = {0, 2, 3};
+    std::memcpy(&direct.bin[direct.index_offset + 6], corners, 6);
+    expect_same_mesh(load(sparse, "sparse_i.gltf"), load(direct, "direct_i.gltf"), "indices");
+  }
+}
+
 // With a mirroring scale the triangles are rewound so that they still face outwards, and the
 // tangents (computed for the normal map) change handedness.
 TEST_F(GltfTest, MirroringNodeKeepsFacesOutwardAndFlipsTangentHandedness) {
@@ -285,6 +373,27 @@ std::vector<BadCase> bad_cases() {
          return j.dump();
        },
        "buffer 0: the data URI is not base64 ('data:application/octet-stream,hello')"},
+      {"SparseIndexPastTheCount", "sparse_range.gltf",
+       [](GltfParts g, const std::string&) {
+         add_sparse(g, 0, 5123, {3, 24}, test::float_bytes(std::vector<float>(6, 0.0f)));
+         return test::as_gltf(g);
+       },
+       "mesh 0 primitive 0: accessor 0: sparse: index 24 at 1 is out of range or not increasing "
+       "(count 24)"},
+      {"SparseIndicesNotIncreasing", "sparse_order.gltf",
+       [](GltfParts g, const std::string&) {
+         add_sparse(g, 0, 5125, {5, 5}, test::float_bytes(std::vector<float>(6, 0.0f)));
+         return test::as_gltf(g);
+       },
+       "mesh 0 primitive 0: accessor 0: sparse: index 5 at 1 is out of range or not increasing "
+       "(count 24)"},
+      {"SparseValuesPastTheirView", "sparse_values.gltf",
+       [](GltfParts g, const std::string&) {
+         add_sparse(g, 0, 5121, {1, 2}, test::float_bytes(std::vector<float>(5, 0.0f)));
+         return test::as_gltf(g);
+       },
+       "mesh 0 primitive 0: accessor 0: sparse values: bytes 0 + 24 run past bufferView 5's 20 "
+       "bytes"},
       {"TruncatedGlb", "cut.glb",
        [](GltfParts g, const std::string&) {
          std::string glb = test::as_glb(g);

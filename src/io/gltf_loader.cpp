@@ -65,15 +65,60 @@ int type_components(int type) {
   }
 }
 
+// The bytes [offset, offset + length) of bufferView `view`, checked to lie inside the view and the
+// view inside its buffer.
+Result<const uint8_t*> view_bytes(const tg::Model& m, int view, uint64_t offset, uint64_t length,
+                                  const std::string& what) {
+  if (view < 0 || size_t(view) >= m.bufferViews.size()) {
+    return fail(what, "bufferView " + std::to_string(view) + " does not exist");
+  }
+  const tg::BufferView& v = m.bufferViews[size_t(view)];
+  std::string view_what = "bufferView " + std::to_string(view);
+  if (v.buffer < 0 || size_t(v.buffer) >= m.buffers.size()) {
+    return fail(view_what, "buffer " + std::to_string(v.buffer) + " does not exist");
+  }
+  const std::vector<unsigned char>& data = m.buffers[size_t(v.buffer)].data;
+  if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset) {
+    return fail(view_what, "bytes " + n(v.byteOffset) + " + " + n(v.byteLength) +
+                               " run past its buffer's " + n(data.size()));
+  }
+  if (offset > v.byteLength || length > v.byteLength - offset) {
+    return fail(what, "bytes " + n(offset) + " + " + n(length) + " run past " + view_what + "'s " +
+                          n(v.byteLength) + " bytes");
+  }
+  return data.data() + v.byteOffset + offset;
+}
+
 // Where an accessor's elements are: checked to lie inside the view and the view inside its buffer.
+// Without a bufferView the elements are zeros (`first` null), as glTF defines. A sparse accessor
+// then replaces the elements its strictly increasing indices name by its tightly packed values.
 struct AccessorBytes {
-  const uint8_t* first = nullptr;
+  const uint8_t* first = nullptr;  // null: every element is zero
   size_t stride = 0;
   size_t count = 0;
   int components = 0;
   int component_type = 0;
   bool normalized = false;
+  size_t sparse_count = 0;
+  const uint8_t* sparse_indices = nullptr;
+  int sparse_index_bytes = 0;  // 1, 2 or 4
+  const uint8_t* sparse_values = nullptr;
 };
+
+template <class T>
+T load_as(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// The k-th index of a sparse accessor.
+uint32_t sparse_index(const AccessorBytes& a, size_t k) {
+  const uint8_t* p = a.sparse_indices + k * size_t(a.sparse_index_bytes);
+  return a.sparse_index_bytes == 1   ? load_as<uint8_t>(p)
+         : a.sparse_index_bytes == 2 ? load_as<uint16_t>(p)
+                                     : load_as<uint32_t>(p);
+}
 
 Result<AccessorBytes> locate(const tg::Model& m, int index, const std::vector<int>& allowed_types,
                              uint64_t max_count) {
@@ -89,49 +134,84 @@ Result<AccessorBytes> locate(const tg::Model& m, int index, const std::vector<in
     return fail(what, "has the wrong type for its use (" + n(uint64_t(a.type)) + ")");
   }
   if (bytes == 0) return fail(what, "unknown componentType " + std::to_string(a.componentType));
-  if (a.sparse.isSparse) return fail(what, "sparse accessors are not supported");
   if (a.count > max_count) {
     return fail(what, "count " + n(a.count) + " is over the limit of " + n(max_count));
   }
   r.count = a.count;
-  if (a.bufferView < 0 || size_t(a.bufferView) >= m.bufferViews.size()) {
-    return fail(what, "bufferView " + std::to_string(a.bufferView) + " does not exist");
-  }
-  const tg::BufferView& v = m.bufferViews[size_t(a.bufferView)];
-  std::string view_what = "bufferView " + std::to_string(a.bufferView);
-  if (v.buffer < 0 || size_t(v.buffer) >= m.buffers.size()) {
-    return fail(view_what, "buffer " + std::to_string(v.buffer) + " does not exist");
-  }
-  const std::vector<unsigned char>& data = m.buffers[size_t(v.buffer)].data;
-  if (v.byteOffset > data.size() || v.byteLength > data.size() - v.byteOffset) {
-    return fail(view_what, "bytes " + n(v.byteOffset) + " + " + n(v.byteLength) +
-                               " run past its buffer's " + n(data.size()));
-  }
   uint64_t element = uint64_t(r.components) * uint64_t(bytes);
-  r.stride = v.byteStride ? v.byteStride : size_t(element);
-  if (r.stride < element) {
-    return fail(what,
-                "byteStride " + n(r.stride) + " is less than its element (" + n(element) + ")");
+  if (a.bufferView >= 0) {  // without one, zeros
+    if (size_t(a.bufferView) >= m.bufferViews.size()) {
+      return fail(what, "bufferView " + std::to_string(a.bufferView) + " does not exist");
+    }
+    const tg::BufferView& v = m.bufferViews[size_t(a.bufferView)];
+    Result<const uint8_t*> view = view_bytes(m, a.bufferView, 0, 0, what);
+    if (!view) return view.status();
+    r.stride = v.byteStride ? v.byteStride : size_t(element);
+    if (r.stride < element) {
+      return fail(what,
+                  "byteStride " + n(r.stride) + " is less than its element (" + n(element) + ")");
+    }
+    if (r.count > 0) {
+      // offset + (count - 1) * stride + element <= byteLength, without overflow.
+      uint64_t length = v.byteLength;
+      bool fits = a.byteOffset <= length && element <= length - a.byteOffset &&
+                  (r.count - 1) <= (length - a.byteOffset - element) / r.stride;
+      if (!fits) {
+        return fail(what, n(r.count) + " elements of " + n(element) + " bytes (stride " +
+                              n(r.stride) + ") from byte " + n(a.byteOffset) +
+                              " run past bufferView " + std::to_string(a.bufferView) + "'s " +
+                              n(length) + " bytes");
+      }
+      r.first = *view + a.byteOffset;
+    }
   }
-  if (r.count == 0) return r;
-  // offset + (count - 1) * stride + element <= byteLength, without overflow.
-  uint64_t length = v.byteLength;
-  bool fits = a.byteOffset <= length && element <= length - a.byteOffset &&
-              (r.count - 1) <= (length - a.byteOffset - element) / r.stride;
-  if (!fits) {
-    return fail(what, n(r.count) + " elements of " + n(element) + " bytes (stride " + n(r.stride) +
-                          ") from byte " + n(a.byteOffset) + " run past bufferView " +
-                          std::to_string(a.bufferView) + "'s " + n(length) + " bytes");
+  if (!a.sparse.isSparse) return r;
+  const std::string sparse_what = what + ": sparse";
+  if (a.sparse.count < 1 || uint64_t(a.sparse.count) > r.count) {
+    return fail(sparse_what,
+                "count " + std::to_string(a.sparse.count) + " is not in 1.." + n(r.count));
   }
-  r.first = data.data() + v.byteOffset + a.byteOffset;
+  r.sparse_count = size_t(a.sparse.count);
+  switch (a.sparse.indices.componentType) {
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+      r.sparse_index_bytes = component_bytes(a.sparse.indices.componentType);
+      break;
+    default:
+      return fail(sparse_what, "indices must be unsigned integers");
+  }
+  if (a.sparse.indices.byteOffset < 0 || a.sparse.values.byteOffset < 0) {
+    return fail(sparse_what, "negative byteOffset");
+  }
+  Result<const uint8_t*> indices = view_bytes(
+      m, a.sparse.indices.bufferView, uint64_t(a.sparse.indices.byteOffset),
+      uint64_t(r.sparse_count) * uint64_t(r.sparse_index_bytes), sparse_what + " indices");
+  if (!indices) return indices.status();
+  Result<const uint8_t*> values =
+      view_bytes(m, a.sparse.values.bufferView, uint64_t(a.sparse.values.byteOffset),
+                 uint64_t(r.sparse_count) * element, sparse_what + " values");
+  if (!values) return values.status();
+  r.sparse_indices = *indices;
+  r.sparse_values = *values;
+  for (size_t k = 0; k < r.sparse_count; ++k) {
+    uint32_t i = sparse_index(r, k);
+    if (i >= r.count || (k > 0 && i <= sparse_index(r, k - 1))) {
+      return fail(sparse_what, "index " + n(i) + " at " + n(k) +
+                                   " is out of range or not increasing (count " + n(r.count) + ")");
+    }
+  }
   return r;
 }
 
-template <class T>
-T load_as(const uint8_t* p) {
-  T v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
+// Element i's bytes: its sparse value if it has one (`next_sparse` walks the sparse indices in
+// order as i increases), else the base element, or null for a zero element.
+const uint8_t* element_at(const AccessorBytes& a, size_t i, size_t& next_sparse) {
+  if (next_sparse < a.sparse_count && sparse_index(a, next_sparse) == i) {
+    size_t element = size_t(a.components) * size_t(component_bytes(a.component_type));
+    return a.sparse_values + next_sparse++ * element;
+  }
+  return a.first ? a.first + i * a.stride : nullptr;
 }
 
 // One component as a float: normalised integers by glTF's rules, others converted.
@@ -167,10 +247,11 @@ Status read_floats(const tg::Model& m, int index, const std::vector<int>& types,
   if (!a) return a.status();
   int bytes = component_bytes(a->component_type);
   out.assign(a->count, fill);
+  size_t next_sparse = 0;
   for (size_t i = 0; i < a->count; ++i) {
-    const uint8_t* p = a->first + i * a->stride;
+    const uint8_t* p = element_at(*a, i, next_sparse);
     for (int c = 0; c < std::min(a->components, width); ++c)
-      out[i][c] = component(*a, p + c * bytes);
+      out[i][c] = p ? component(*a, p + c * bytes) : 0.0f;
   }
   return {};
 }
@@ -185,9 +266,11 @@ Status read_indices(const tg::Model& m, int index, std::vector<uint32_t>& out) {
     return fail("accessor " + std::to_string(index), "indices must be unsigned integers");
   }
   out.resize(a->count);
+  size_t next_sparse = 0;
   for (size_t i = 0; i < a->count; ++i) {
-    const uint8_t* p = a->first + i * a->stride;
-    out[i] = type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? load_as<uint8_t>(p)
+    const uint8_t* p = element_at(*a, i, next_sparse);
+    out[i] = p == nullptr                                     ? 0u
+             : type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE  ? load_as<uint8_t>(p)
              : type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? load_as<uint16_t>(p)
                                                               : load_as<uint32_t>(p);
   }
