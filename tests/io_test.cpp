@@ -359,6 +359,91 @@ TEST_F(IoTest, ObjQuadWithMaterialAndTexture) {
   EXPECT_FLOAT_EQ(m.diffuse_map->texel(0, 0).r * 255.0f, 50.0f);  // v = 0 is the bottom
 }
 
+// The files a model names, as its author meant them (find_referenced_file): as written; with
+// Windows' backslashes; ignoring case in folders and names (the first match in name order); and,
+// where the folders do not exist here, the file of that name beside the model. Before, each of
+// these left the model untextured or without its materials.
+TEST_F(IoTest, ReferencedFilesAreFoundAsTheirAuthorMeantThem) {
+  fs::create_directories(dir_ / "Maps" / "Wood");
+  write("Maps/Wood/Oak.PNG", "x");
+  write("checker.png", "x");
+  write("A.tga", "x");
+  write("a.tga", "x");
+  const std::string folder = dir_.string();
+  auto found = [&](const std::string& name) {
+    std::optional<std::string> f = find_referenced_file(folder, name);
+    return f ? fs::path(*f).lexically_normal().lexically_relative(dir_).generic_string()
+             : std::string("(none)");
+  };
+  EXPECT_EQ(found("checker.png"), "checker.png");
+  EXPECT_EQ(found("Maps/Wood/Oak.PNG"), "Maps/Wood/Oak.PNG");
+  EXPECT_EQ(found("Maps\\Wood\\Oak.PNG"), "Maps/Wood/Oak.PNG");
+  EXPECT_EQ(found("maps/wood/oak.png"), "Maps/Wood/Oak.PNG");
+  EXPECT_EQ(found("MAPS\\WOOD\\OAK.png"), "Maps/Wood/Oak.PNG");
+  EXPECT_EQ(found("./maps/../Maps/wood/oak.png"), "Maps/Wood/Oak.PNG");
+  EXPECT_EQ(found("a.TGA"), "A.tga");  // both match: the first in name order
+  EXPECT_EQ(found("C:\\Users\\artist\\CHECKER.PNG"), "checker.png");
+  EXPECT_EQ(found("/home/artist/textures/checker.png"), "checker.png");
+  EXPECT_EQ(found("missing.png"), "(none)");
+  EXPECT_EQ(found("Maps/missing.png"), "(none)");
+  EXPECT_EQ(found(""), "(none)");
+
+  // Through load_obj: an MTL named with another case and a folder of the author's machine, its
+  // maps with backslashes and another case, and one by an absolute path from elsewhere.
+  Image image(2, 2);
+  ASSERT_TRUE(save_image(path("Maps/Wood/Oak.PNG"), image).ok());
+  ASSERT_TRUE(save_image(path("checker.png"), image).ok());
+  write("Model.MTL",
+        "newmtl wood\nmap_Kd maps\\wood\\oak.png\nnewmtl check\n"
+        "map_Kd D:\\work\\textures\\Checker.png\n");
+  write("model.obj", std::string("mtllib C:\\Users\\artist\\model.mtl\n") + kQuadPositions +
+                         "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl wood\nf 1/1 2/2 3/3\n"
+                         "usemtl check\nf 1/1 3/3 4/4\n");
+  Result<Mesh> mesh = load_obj(path("model.obj"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  ASSERT_EQ(mesh->materials.size(), 2u);
+  EXPECT_NE(mesh->materials[0].diffuse_map, nullptr);
+  EXPECT_NE(mesh->materials[1].diffuse_map, nullptr);
+  // Found as written but for separators and case: silent. From another machine's folder: a
+  // warning naming the file taken, for the MTL and for the second map.
+  ASSERT_EQ(mesh->warnings.size(), 2u);
+  EXPECT_NE(mesh->warnings[0].find("material library 'C:\\Users\\artist\\model.mtl' is not "
+                                   "there; took "),
+            std::string::npos)
+      << mesh->warnings[0];
+  EXPECT_NE(mesh->warnings[0].find("Model.MTL"), std::string::npos) << mesh->warnings[0];
+  EXPECT_NE(mesh->warnings[1].find("material 'check': map_Kd: 'D:\\work\\textures\\Checker.png' "
+                                   "is not there; took "),
+            std::string::npos)
+      << mesh->warnings[1];
+}
+
+// `usemtl` of a name that no MTL defines is drawn with the default colour and says so, once per
+// name and with its line, when the OBJ's libraries were read; an OBJ without libraries (many
+// exporters write "usemtl default" alone) or with a missing one (which has its own warning) adds
+// no such line.
+TEST_F(IoTest, ObjUsemtlOfAnUndefinedMaterialIsAWarning) {
+  write("one.mtl", "newmtl red\nKd 1 0 0\n");
+  const std::string faces = std::string(kQuadPositions) + "usemtl red\nf 1 2 3\n" +
+                            "usemtl blue\nf 1 3 4\nusemtl blue\nf 1 2 4\nusemtl\nf 2 3 4\n";
+  write("with.obj", "mtllib one.mtl\n" + faces);
+  write("without.obj", faces);
+  write("missing.obj", "mtllib gone.mtl\n" + faces);
+  Result<Mesh> with = load_obj(path("with.obj"));
+  ASSERT_TRUE(with.ok()) << with.status().message();
+  ASSERT_EQ(with->warnings.size(), 1u);
+  EXPECT_EQ(with->warnings[0], path("with.obj") +
+                                   ":8: usemtl 'blue': no material of that name in the MTL files "
+                                   "read; drawn with the default colour");
+  Result<Mesh> without = load_obj(path("without.obj"));
+  ASSERT_TRUE(without.ok()) << without.status().message();
+  EXPECT_TRUE(without->warnings.empty());
+  Result<Mesh> missing = load_obj(path("missing.obj"));
+  ASSERT_TRUE(missing.ok()) << missing.status().message();
+  ASSERT_EQ(missing->warnings.size(), 1u);
+  EXPECT_NE(missing->warnings[0].find("material library 'gone.mtl' not found"), std::string::npos);
+}
+
 TEST_F(IoTest, ObjMaterialsRunsDefaultsAndSharedTextures) {
   ASSERT_TRUE(save_image(path("shared.png"), pattern(2, 2)).ok());
   write("m.mtl",

@@ -59,8 +59,13 @@ std::vector<std::string_view> words_of(std::string_view line) {
   return words;
 }
 
+// Resolved as load_obj resolves it (find_referenced_file: Windows separators, case, a folder of
+// the author's machine).
 Reference reference(std::string kind, std::string_view path, const fs::path& folder) {
   Reference r{std::move(kind), std::string(path), folder / std::string(path), false};
+  if (std::optional<std::string> found = find_referenced_file(folder.string(), r.path)) {
+    r.resolved = *found;
+  }
   std::error_code ec;
   r.found = fs::is_regular_file(r.resolved, ec);
   return r;

@@ -87,12 +87,13 @@ inline constexpr int64_t kMaxMtlFileBytes = int64_t(64) << 20;
 // map_Kd, map_Ks, map_d, and norm, map_Bump or bump with -bm as tangent-space normal maps; a
 // greyscale bump map is a height map, turned into a normal map); v, vt, vn, f, usemtl and
 // mtllib are read, other statements skipped. Texture paths are relative to the MTL file, MTL
-// paths to the OBJ. An OBJ with no materials at all takes the maps of the tutorial models'
-// convention beside it, when they exist: <model>_diffuse.tga, <model>_spec.tga, and
-// <model>_nm_tangent.tga (tangent space) or else <model>_nm.tga (object space), as one material
-// named after the model. A material with a tangent-space normal map gets Mesh::tangents. A missing
-// MTL leaves its materials undefined (their faces get the default material) and a missing or
-// unreadable map_Kd leaves its material untextured; both add a line to Mesh::warnings:
+// paths to the OBJ, and found as find_referenced_file finds them (Windows separators, case). An OBJ
+// with no materials at all takes the maps of the tutorial models' convention beside it, when they
+// exist: <model>_diffuse.tga, <model>_spec.tga, and <model>_nm_tangent.tga (tangent space) or else
+// <model>_nm.tga (object space), as one material named after the model. A material with a
+// tangent-space normal map gets Mesh::tangents. A missing MTL leaves its materials undefined (their
+// faces get the default material) and a missing or unreadable map_Kd leaves its material
+// untextured; both add a line to Mesh::warnings:
 //   "model.obj:1: material library 'model.mtl' not found; its materials get the default colour"
 //   "model.obj: material 'skin': map_Kd: skin.png: cannot open: No such file or directory; drawn
 //    without this texture"  (the second part is load_image's message)
@@ -103,6 +104,13 @@ inline constexpr int64_t kMaxMtlFileBytes = int64_t(64) << 20;
 // one or not finite as a float, a face with fewer than 3 corners or an index that is zero, out
 // of range or overflowing, no faces, an MTL file that exists but cannot be read or is malformed.
 Result<Mesh> load_obj(const std::string& path);
+
+// The file an OBJ or MTL names (an MTL library or a map) relative to `folder`, as load_obj finds
+// it: the path as written; else with backslashes read as folder separators (files written on
+// Windows); else its folders and name matched without regard to case; else, where its folders do
+// not exist here (an absolute path from the author's machine), the file of that name in `folder`
+// (load_obj then adds a warning naming the file it took). nullopt when none exists.
+std::optional<std::string> find_referenced_file(const std::string& folder, const std::string& name);
 
 // Loads a PLY file: ASCII, binary little or big endian. The vertex element's x, y, z, and when
 // present nx, ny, nz and u, v (or s, t, texture_u, texture_v, texture_s, texture_t); colours and
@@ -138,8 +146,9 @@ inline constexpr int64_t kMaxGltfTriangles = int64_t(1) << 25;
 // missing or unreadable image is a warning. Errors are one line naming the file and the object
 // ("scene.gltf: accessor 3: 24 elements of 12 bytes need 288 bytes from byte 0, but bufferView 1
 // has 200"): invalid JSON or GLB framing, a buffer file missing or of the wrong size, a data URI
-// that is not base64, an index out of range, accessors past their bufferView, sparse accessors,
-// non-finite positions, counts over kMaxGltfVertices / kMaxGltfTriangles, no triangles.
+// that is not base64, an index out of range, accessors (or their sparse indices and values) past
+// their bufferView, sparse indices out of range or not increasing, non-finite positions, counts
+// over kMaxGltfVertices / kMaxGltfTriangles, no triangles.
 Result<Mesh> load_gltf(const std::string& path);
 
 // Loads a model, telling the format by content: glTF by "{ ... "asset"" or GLB's magic, PLY by

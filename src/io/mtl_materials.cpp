@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include <glm/geometric.hpp>
+#include "io/file_lookup.hpp"
 #include "io/obj_piece.hpp"
 #include "io/text_lines.hpp"
 
@@ -83,16 +84,25 @@ std::vector<MtlGiven> scan_given(const std::string& text) {
 Status ObjMaterials::load_library(const std::string& name, const std::string& obj_path,
                                   size_t obj_line) {
   if (!loaded_.insert(name).second) return {};
-  fs::path path = obj_dir_ / name;
-  std::error_code ignored;
-  if (!fs::exists(path, ignored)) {
+  std::optional<FoundFile> found = find_named_file(obj_dir_, name);
+  if (!found) {
+    library_missing_ = true;
     warnings_.push_back(obj_path + ":" + std::to_string(obj_line) + ": material library '" + name +
                         "' not found; its materials get the default colour");
     return {};
   }
+  fs::path path = found->path;
+  if (found->how == FoundAs::kBeside) {
+    warnings_.push_back(obj_path + ":" + std::to_string(obj_line) + ": material library '" + name +
+                        "' is not there; took " + path.string() +
+                        ", the file of its name beside "
+                        "the model");
+  }
+  std::error_code ignored;
   if (fs::exists(path, ignored) && !fs::is_regular_file(path, ignored) &&
       !fs::is_directory(path, ignored)) {
     // A pipe or device that a model names (opening a FIFO would wait for a writer forever).
+    library_missing_ = true;
     warnings_.push_back(obj_path + ":" + std::to_string(obj_line) + ": material library '" + name +
                         "' is not a regular file (a pipe or device); its materials get the "
                         "default colour");
@@ -122,6 +132,17 @@ Status ObjMaterials::load_library(const std::string& name, const std::string& ob
   given_.insert(given_.end(), given.begin(), given.end());
   dirs_.resize(all_.size(), path.parent_path());
   return {};
+}
+
+int ObjMaterials::use(const std::string& name, const std::string& obj_path, size_t obj_line) {
+  int index = id(name);
+  if (index < 0 && !name.empty() && !loaded_.empty() && !library_missing_ &&
+      unknown_.insert(name).second) {
+    warnings_.push_back(obj_path + ":" + std::to_string(obj_line) + ": usemtl '" + name +
+                        "': no material of that name in the MTL files read; drawn with the "
+                        "default colour");
+  }
+  return index;
 }
 
 namespace {
@@ -204,8 +225,15 @@ std::optional<LoadedMap> load_map(const fs::path& dir, const std::string& name, 
                                   const std::string& statement,
                                   std::vector<std::string>& warnings) {
   if (name.empty()) return std::nullopt;
-  Result<LoadedMap> map = texture_at(dir / name, cache, kind, bump_scale);
-  if (map.ok()) return *map;
+  std::optional<FoundFile> found = find_named_file(dir, name);
+  Result<LoadedMap> map = texture_at(found ? found->path : dir / name, cache, kind, bump_scale);
+  if (map.ok()) {
+    if (found->how == FoundAs::kBeside) {
+      warnings.push_back(where + statement + ": '" + name + "' is not there; took " +
+                         found->path.string() + ", the file of its name beside the material");
+    }
+    return *map;
+  }
   warnings.push_back(where + statement + ": " + map.status().message() +
                      "; drawn without this texture");
   return std::nullopt;

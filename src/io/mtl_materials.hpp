@@ -46,6 +46,12 @@ class ObjMaterials {
   Result<std::vector<Material>> convert(const std::string& path,
                                         std::vector<std::string>& warnings) const;
 
+  // id() for `usemtl name` at line `obj_line` of `obj_path`. A name that no library defines adds a
+  // warning, once per name, when the OBJ's libraries were all read (a missing one has its own)
+  // and at least one was: "model.obj:12: usemtl 'skin': no material of that name in the MTL files
+  // read; drawn with the default colour".
+  int use(const std::string& name, const std::string& obj_path, size_t obj_line);
+
   std::vector<std::string> take_warnings() { return std::move(warnings_); }
 
  private:
@@ -57,6 +63,8 @@ class ObjMaterials {
   std::vector<std::filesystem::path> dirs_;
   std::vector<MtlGiven> given_;
   std::vector<std::string> warnings_;
+  bool library_missing_ = false;   // a library the OBJ named was not read
+  std::set<std::string> unknown_;  // the undefined names already warned about
 };
 
 // The material of the tutorial models' convention for the OBJ at `obj_path` (see load_obj):

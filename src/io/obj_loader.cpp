@@ -333,7 +333,7 @@ Status ObjMerge::merge(ObjPiece& piece) {
   for (const detail::ObjEvent& event : piece.events) {
     add_faces(piece, offset, event.face, indices);
     if (!event.mtllib) {
-      material_ = materials_.id(event.names[0]);
+      material_ = materials_.use(event.names[0], path_, lines_ + event.line);
     } else if (Status s = load_libraries(event); !s.ok()) {
       return s;
     }
