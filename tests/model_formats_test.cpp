@@ -230,6 +230,32 @@ TEST_F(ModelFormatsTest, EveryEncodingLoadsTheSameTrianglesAndRendersTheSameImag
   EXPECT_TRUE(load_stl(write("a.stl", stl_ascii())).ok());
 }
 
+// STL as some writers make it: ASCII keywords in upper case; a binary file with bytes after its
+// triangles (padding, or the writer's own data), also when its header begins with "solid". The
+// same triangles as the plain files; the extra bytes are a warning. Before, each was refused.
+TEST_F(ModelFormatsTest, StlInUpperCaseOrWithTrailingBytesLoads) {
+  Result<Mesh> obj = load_model(write("box.obj", obj_text()));
+  ASSERT_TRUE(obj.ok()) << obj.status().message();
+  std::vector<Corner> expected = corners(*obj);
+  std::string upper = stl_ascii();
+  for (char& c : upper) c = char(std::toupper((unsigned char)c));
+  Result<Mesh> mesh = load_model(write("upper.model", upper));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  EXPECT_EQ(corners(*mesh), expected);
+  EXPECT_TRUE(mesh->warnings.empty());
+  std::string solid_header = stl_binary();
+  std::memcpy(solid_header.data(), "solid binary    ", 16);
+  for (const std::string& binary : {stl_binary(), solid_header}) {
+    std::string p = write("padded.stl", binary + std::string(7, '\0'));
+    mesh = load_model(p);
+    ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+    EXPECT_EQ(corners(*mesh), expected);
+    ASSERT_EQ(mesh->warnings.size(), 1u);
+    EXPECT_EQ(mesh->warnings[0],
+              p + ": 7 bytes after the 12 triangles the binary STL declares are ignored");
+  }
+}
+
 TEST_F(ModelFormatsTest, EveryTruncationIsAClearError) {
   for (const Encoded& e : encodings()) {
     // Every cut short of the last byte (for the text formats, the final newline, without which

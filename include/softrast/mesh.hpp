@@ -121,11 +121,11 @@ std::optional<std::string> find_referenced_file(const std::string& folder, const
 // 65536 items, a number that does not fit its type, a vertex index out of range, no faces.
 Result<Mesh> load_ply(const std::string& path);
 
-// Loads an STL file, binary (exactly 84 + 50 * count bytes) or ASCII (solid ... endsolid). Every
-// triangle gets three vertices of its own with the facet normal (the triangle's own normal where
-// the facet normal is zero or not finite), uv (0, 0). Errors: a size that disagrees with the
-// count (truncated), a keyword out of place or missing (the file and line), a number that is not
-// one or not finite, no triangles.
+// Loads an STL file, binary (84 + 50 * count bytes; bytes after the triangles are a warning) or
+// ASCII (solid ... endsolid, keywords in any case). Every triangle gets three vertices of its
+// own with the facet normal (the triangle's own normal where the facet normal is zero or not
+// finite), uv (0, 0). Errors: fewer bytes than the count needs (truncated), a keyword out of
+// place or missing (the file and line), a number that is not one or not finite, no triangles.
 Result<Mesh> load_stl(const std::string& path);
 
 // Largest glTF or GLB file, and largest external buffer, load_gltf reads: 1 GiB.

@@ -89,7 +89,10 @@ bool starts_solid(std::string_view head) {
   size_t first = head.find_first_not_of(" \t\r\n");
   if (first == std::string_view::npos) return false;
   std::string_view rest = head.substr(first);
-  return starts_with(rest, "solid") && (rest.size() == 5 || std::isspace((unsigned char)rest[5]));
+  if (rest.size() < 5) return false;
+  std::string first_word(rest.substr(0, 5));
+  for (char& c : first_word) c = char(std::tolower((unsigned char)c));  // "SOLID" too
+  return first_word == "solid" && (rest.size() == 5 || std::isspace((unsigned char)rest[5]));
 }
 
 // The first kSniffBytes of the file and its size; for a pipe or device (no size, -1) nothing

@@ -2,11 +2,11 @@
 //
 // No library: Debian has none for STL alone, and the format is two pages. Binary: an 80-byte
 // header, a little-endian triangle count, then 50 bytes per triangle (normal, three vertices, a
-// 16-bit attribute); the file size must be exactly 84 + 50 * count. ASCII: `solid NAME`, then
-// `facet normal nx ny nz / outer loop / vertex x y z` (three) `/ endloop / endfacet`, then
-// `endsolid NAME` (several solids may follow one another). Each triangle gets three vertices of
-// its own whose normal is the facet normal; a zero or non-finite facet normal (common in
-// exported files) is replaced by the triangle's own, counter-clockwise.
+// 16-bit attribute); bytes past 84 + 50 * count are ignored with a warning. ASCII: `solid NAME`,
+// then `facet normal nx ny nz / outer loop / vertex x y z` (three) `/ endloop / endfacet`, then
+// `endsolid NAME` (several solids may follow one another; keywords in any case). Each triangle gets
+// three vertices of its own whose normal is the facet normal; a zero or non-finite facet normal
+// (common in exported files) is replaced by the triangle's own, counter-clockwise.
 
 #include <cmath>
 #include <cstring>
@@ -79,10 +79,10 @@ Result<Mesh> parse_binary(const char* data, size_t size, const std::string& name
   }
   uint64_t count = little32(data + 80);
   uint64_t expected = 84 + 50 * count;
-  if (expected != size) {
+  if (expected > size) {
     return fail(name, "binary STL declares " + std::to_string(count) + " triangles (" +
                           std::to_string(expected) + " bytes) but has " + std::to_string(size) +
-                          " bytes" + (size < expected ? " (truncated)" : ""));
+                          " bytes (truncated)");
   }
   if (count == 0) return fail(name, "no triangles");
   if (count > kMaxTriangles) return fail(name, "too many triangles");
@@ -104,6 +104,11 @@ Result<Mesh> parse_binary(const char* data, size_t size, const std::string& name
       }
     }
     add_triangle(mesh, p, normal);
+  }
+  if (expected < size) {  // some writers pad the file or append their own data
+    mesh.warnings.push_back(name + ": " + std::to_string(size - expected) + " bytes after the " +
+                            std::to_string(count) +
+                            " triangles the binary STL declares are ignored");
   }
   return mesh;
 }
@@ -136,6 +141,18 @@ class Words {
   size_t line_ = 1;
 };
 
+// Keywords are compared without regard to case: the format's are lower case, but some writers
+// use upper case ("SOLID", "FACET NORMAL").
+bool same_word(std::string_view word, std::string_view keyword) {
+  if (word.size() != keyword.size()) return false;
+  for (size_t i = 0; i < word.size(); ++i) {
+    char c = word[i];
+    if (c >= 'A' && c <= 'Z') c = char(c - 'A' + 'a');
+    if (c != keyword[i]) return false;
+  }
+  return true;
+}
+
 class AsciiStl {
  public:
   AsciiStl(const char* data, size_t size, const std::string& name)
@@ -149,7 +166,7 @@ class AsciiStl {
   }
   Status expect(std::string_view keyword) {
     std::string_view w = words_.next();
-    if (w == keyword) return {};
+    if (same_word(w, keyword)) return {};
     if (w.empty())
       return error("the file ends where '" + std::string(keyword) + "' should be (truncated)");
     return error("expected '" + std::string(keyword) + "', found '" + printable(w) + "'");
@@ -209,13 +226,13 @@ Result<Mesh> AsciiStl::parse() {
   words_.skip_line();
   for (;;) {
     std::string_view w = words_.next();
-    if (w == "facet") {
+    if (same_word(w, "facet")) {
       if (Status s = facet(); !s.ok()) return s;
-    } else if (w == "endsolid") {
+    } else if (same_word(w, "endsolid")) {
       words_.skip_line();
       std::string_view after = words_.next();
       if (after.empty()) break;
-      if (after != "solid")
+      if (!same_word(after, "solid"))
         return error("expected 'solid' or the end, found '" + printable(after) + "'");
       words_.skip_line();
     } else if (w.empty()) {
@@ -237,7 +254,13 @@ bool is_binary_stl(const char* data, size_t size) {
 Result<Mesh> parse_stl(const char* data, size_t size, bool binary, const std::string& name) {
   if (size == 0) data = "";  // an empty vector's data() may be null, which memchr must not get
   if (binary) return parse_binary(data, size, name);
-  return AsciiStl(data, size, name).parse();
+  Result<Mesh> mesh = AsciiStl(data, size, name).parse();
+  if (!mesh.ok() && size >= 84 && 84 + 50 * uint64_t(little32(data + 80)) < size) {
+    // A binary file whose header begins with "solid" (some writers put it there) and that has
+    // bytes after its triangles, so that its size did not tell: binary after all if it reads so.
+    if (Result<Mesh> as_binary = parse_binary(data, size, name); as_binary.ok()) return as_binary;
+  }
+  return mesh;
 }
 
 }  // namespace softrast::detail
