@@ -56,7 +56,7 @@ void BM_VertexShader(benchmark::State& state) {
   detail::Lighting lighting;
   lighting.light = glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f));
   detail::GouraudShader<false> shader{
-      {&mesh, glm::mat4(1.0f)}, glm::vec3(0.9f, 0.6f, 0.3f), lighting, 1.0f};
+      {&mesh, glm::mat4(1.0f)}, glm::vec3(0.9f, 0.6f, 0.3f), lighting, 1.0f, {}};
   std::vector<float> out(mesh.positions.size() * 7);
   for (auto _ : state) {
     for (uint32_t i = 0; i < mesh.positions.size(); ++i) {

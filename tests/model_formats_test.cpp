@@ -56,11 +56,15 @@ std::string vec(const glm::vec3& v) {
   return num(v.x) + " " + num(v.y) + " " + num(v.z);
 }
 
-std::string obj_text() {
+// With `coloured`, every position carries the PLY files' colour (200, 100, 50) / 255 as an OBJ
+// vertex colour, written so that it reads back as the same float.
+std::string obj_text(bool coloured = false) {
   std::string s = "# box\n";
+  std::string colour;  // appended: "..." + std::string draws GCC 12's false -Wrestrict here
+  for (double c : {200.0, 100.0, 50.0}) colour.append(" ").append(num(float(c / 255.0)));
   int k = 0;
   for (const Quad& q : box()) {
-    for (const glm::vec3& p : q.p) s += "v " + vec(p) + "\n";
+    for (const glm::vec3& p : q.p) s += "v " + vec(p) + (coloured ? colour : "") + "\n";
     s += "vn " + vec(q.n) + "\n";
     ++k;
     std::string n = std::to_string(k);
@@ -210,19 +214,27 @@ std::vector<Encoded> encodings() {
           {"binary.stl", stl_binary()}};
 }
 
+// The PLY files carry vertex colours, drawn as the albedo: they render as the OBJ with the same
+// colours (OBJ vertex colours), the STL files as the plain OBJ.
 TEST_F(ModelFormatsTest, EveryEncodingLoadsTheSameTrianglesAndRendersTheSameImage) {
   Result<Mesh> obj = load_model(write("box.obj", obj_text()));
+  Result<Mesh> coloured_obj = load_model(write("coloured.obj", obj_text(true)));
   ASSERT_TRUE(obj.ok()) << obj.status().message();
+  ASSERT_TRUE(coloured_obj.ok()) << coloured_obj.status().message();
   ASSERT_EQ(obj->triangle_count(), 12u);
   std::vector<Corner> expected = corners(*obj);
-  Image expected_image = render(*obj);
+  EXPECT_EQ(corners(*coloured_obj), expected);
+  Image expected_image = render(*obj), coloured_image = render(*coloured_obj);
+  EXPECT_FALSE(coloured_image.rgba == expected_image.rgba);
   for (const Encoded& e : encodings()) {
     // Named .model so that only the content can tell the format.
     std::string path = write(std::string(e.name) + ".model", e.bytes);
     Result<Mesh> mesh = load_model(path);
     ASSERT_TRUE(mesh.ok()) << e.name << ": " << mesh.status().message();
     EXPECT_EQ(corners(*mesh), expected) << e.name;
-    EXPECT_TRUE(render(*mesh).rgba == expected_image.rgba) << e.name;
+    const bool ply = std::string(e.name).find(".ply") != std::string::npos;
+    EXPECT_EQ(mesh->colors.empty(), !ply) << e.name;
+    EXPECT_TRUE(render(*mesh).rgba == (ply ? coloured_image : expected_image).rgba) << e.name;
     EXPECT_TRUE(mesh->warnings.empty());
   }
   // The format's own loaders read them too.

@@ -63,7 +63,8 @@ struct Mesh {
   // direction of increasing u, orthogonal to the normal), w = +1 or -1 the handedness, so that
   // the bitangent (increasing v) is w * cross(normal, tangent). compute_tangents fills them.
   std::vector<glm::vec4> tangents;
-  std::vector<glm::vec4> colors;   // linear RGBA vertex colours (glTF COLOR_0, PLY)
+  std::vector<glm::vec4>
+      colors;  // RGBA vertex colours: glTF COLOR_0 (linear), OBJ and PLY (as stored)
   std::vector<glm::vec2> uvs1;     // a second texture coordinate set (glTF TEXCOORD_1)
   std::vector<uint32_t> indices;   // three per triangle
   std::vector<SubMesh> submeshes;  // cover `indices`; empty means one run with material -1
@@ -113,12 +114,14 @@ Result<Mesh> load_obj(const std::string& path);
 std::optional<std::string> find_referenced_file(const std::string& folder, const std::string& name);
 
 // Loads a PLY file: ASCII, binary little or big endian. The vertex element's x, y, z, and when
-// present nx, ny, nz and u, v (or s, t, texture_u, texture_v, texture_s, texture_t); colours and
-// other properties are read and dropped. Faces are the face element's vertex_indices (or
-// vertex_index) list of any integer types, fan-triangulated. Without normals, smooth normals are
-// computed. Errors name the file and the line (ASCII) or the element and byte (binary): a bad
-// header, counts that need more bytes than the file has (checked before allocating), lists over
-// 65536 items, a number that does not fit its type, a vertex index out of range, no faces.
+// present nx, ny, nz and u, v (or s, t, texture_u, texture_v, texture_s, texture_t), and red,
+// green, blue (alpha) as Mesh::colors (integers over their type's largest value, 255 for uchar;
+// floats as they are; clamped to [0, 1]); other properties are read and dropped. Faces are the face
+// element's vertex_indices (or vertex_index) list of any integer types, fan-triangulated. Without
+// normals, smooth normals are computed. Errors name the file and the line (ASCII) or the element
+// and byte (binary): a bad header, counts that need more bytes than the file has (checked before
+// allocating), lists over 65536 items, a number that does not fit its type, a vertex index out of
+// range, no faces.
 Result<Mesh> load_ply(const std::string& path);
 
 // Loads an STL file, binary (84 + 50 * count bytes; bytes after the triangles are a warning) or

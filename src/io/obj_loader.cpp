@@ -236,6 +236,7 @@ class ObjMerge {
   detail::ObjMaterials materials_;
   size_t lines_ = 0;
   ChunkedValues values_[3] = {ChunkedValues(3), ChunkedValues(2), ChunkedValues(3)};
+  std::vector<float> colors_;  // 3 per position when any has a colour (ObjPiece::colors)
   detail::ObjLargest largest_[3];
   VertexTable table_;
   std::vector<std::vector<uint32_t>> index_pieces_;
@@ -320,6 +321,11 @@ Status ObjMerge::merge(ObjPiece& piece) {
     return fail_at(path_, lines_ + piece.lines, "too many faces");
   }
   for (int a = 0; a < 3; ++a) {
+    if (a == 0 && !piece.colors.empty()) {  // colours line up with the positions
+      colors_.resize(3 * values_[0].count(), 1.0f);
+      colors_.insert(colors_.end(), piece.colors.begin(), piece.colors.end());
+      piece.colors = {};
+    }
     values_[a].append(piece.values[a]);
     piece.values[a] = {};
     if (piece.largest[a].value > largest_[a].value) {
@@ -361,6 +367,15 @@ Mesh ObjMerge::build_mesh() {
   }
   size_t position_count = values_[0].count();
   values_[0].release();
+  if (!colors_.empty()) {  // white for the positions after the last coloured one
+    colors_.resize(3 * position_count, 1.0f);
+    mesh.colors.resize(keys.size());
+    for (size_t i = 0; i < keys.size(); ++i) {
+      const float* c = &colors_[3 * size_t(keys[i].v)];
+      mesh.colors[i] = {c[0], c[1], c[2], 1.0f};
+    }
+    colors_ = {};
+  }
   return_free_memory();
   mesh.uvs.resize(keys.size(), glm::vec2(0.0f));
   for (size_t i = 0; i < keys.size(); ++i) {

@@ -3,6 +3,8 @@
 
 #include "io/obj_piece.hpp"
 
+#include <algorithm>
+
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -115,12 +117,14 @@ class PieceParser {
     return false;
   }
 
-  // Appends the stored components from at least `required` numbers; the rest (w, vertex
-  // colours) must be numbers too and are dropped; missing optional ones are 0.
+  // Appends the stored components from at least `required` numbers; the rest must be numbers
+  // too: a position's 4th (w) is dropped, and 6 numbers are a position and its colour (r g b,
+  // 0 to 1, clamped), as MeshLab and other tools write them; missing optional ones are 0.
   bool numbers(ObjWords& words, int attr, size_t required) {
     std::vector<float>& out = p_.values[attr];
     size_t stored = kObjComponents[attr];
     size_t read = 0;
+    float extra[3] = {};
     for (std::string_view w = words.next(); !w.empty(); w = words.next(), ++read) {
       float value = 0.0f;
       ObjNumber n = parse_obj_float(w, value);
@@ -129,6 +133,12 @@ class PieceParser {
         return error("number " + std::string(w) + " is not finite as a 32-bit float");
       }
       if (read < stored) out.push_back(value);
+      if (read >= 3 && read < 6) extra[read - 3] = value;
+    }
+    if (attr == kObjPositions && read == 6) {
+      std::vector<float>& colors = p_.colors;
+      colors.resize(out.size() - 3, 1.0f);  // white for the positions before without one
+      for (float c : extra) colors.push_back(std::clamp(c, 0.0f, 1.0f));
     }
     if (read < required) {
       out.resize(out.size() - read);
@@ -343,6 +353,7 @@ ObjNumber parse_obj_float(std::string_view word, float& value) {
 void parse_obj_piece(ObjPiece& piece) {
   try {
     parse_lines(piece);
+    if (!piece.colors.empty()) piece.colors.resize(piece.values[kObjPositions].size(), 1.0f);
     for (std::vector<float>& v : piece.values) v.shrink_to_fit();
     piece.corners.shrink_to_fit();
     piece.face_sizes.shrink_to_fit();

@@ -71,6 +71,9 @@ struct ObjPiece {
   bool parsed = false;     // set by the parsing thread under the workers' lock
   size_t lines = 0;        // lines parsed (up to and including an error's line)
   std::vector<float> values[3];
+  // Vertex colours ("v x y z r g b"), 3 floats per position of the piece from its first, white
+  // for positions without; empty when no position of the piece has one.
+  std::vector<float> colors;
   std::vector<ObjCorner> corners;    // every face's corners in order
   std::vector<uint32_t> face_sizes;  // corners per face
   size_t triangles = 0;              // sum of face_sizes[i] - 2

@@ -4,9 +4,11 @@
 // 20 MB installed), so this is a strict parser of the format as Greg Turk defined it: a text
 // header of elements and their properties, then the elements in that order. Read: the vertex
 // element's x, y, z (required), nx, ny, nz, and u, v / s, t / texture_u, texture_v /
-// texture_s, texture_t; red, green, blue and any other property are read and dropped (Mesh has no
-// vertex colours). The face element's vertex_indices (or vertex_index) list, of any integer
-// types, fan-triangulated. Other elements (edges, materials, ...) are read past.
+// texture_s, texture_t; red, green, blue (and alpha; also r, g, b, a and diffuse_red, ...) as
+// vertex colours, integers scaled by their type's largest value (255 for uchar), floats as they
+// are, both clamped to [0, 1]; any other property is read and dropped. The face element's
+// vertex_indices (or vertex_index) list, of any integer types, fan-triangulated. Other elements
+// (edges, materials, ...) are read past.
 //
 // Robustness: every element count is checked against the bytes left before anything is reserved
 // (a binary element has a known minimum size; an ASCII value takes at least two bytes), list
@@ -88,8 +90,36 @@ std::optional<Type> type_named(std::string_view name) {
 
 enum class Encoding { kAscii, kLittle, kBig };
 
+// A colour channel in [0, 1]: an integer over its type's largest value (uchar 255, ushort 65535),
+// a float as it is; clamped.
+double colour_channel(Type type, double value) {
+  switch (type) {
+    case Type::kInt8:
+      value /= 127.0;
+      break;
+    case Type::kUint8:
+      value /= 255.0;
+      break;
+    case Type::kInt16:
+      value /= 32767.0;
+      break;
+    case Type::kUint16:
+      value /= 65535.0;
+      break;
+    case Type::kInt32:
+      value /= 2147483647.0;
+      break;
+    case Type::kUint32:
+      value /= 4294967295.0;
+      break;
+    default:
+      break;
+  }
+  return std::clamp(value, 0.0, 1.0);
+}
+
 // What a property is used for.
-enum class Role { kSkip, kX, kY, kZ, kNx, kNy, kNz, kU, kV, kIndices };
+enum class Role { kSkip, kX, kY, kZ, kNx, kNy, kNz, kU, kV, kRed, kGreen, kBlue, kAlpha, kIndices };
 
 struct Property {
   std::string name;
@@ -148,6 +178,10 @@ Role vertex_role(std::string_view name) {
   if (name == "nz") return Role::kNz;
   if (name == "u" || name == "s" || name == "texture_u" || name == "texture_s") return Role::kU;
   if (name == "v" || name == "t" || name == "texture_v" || name == "texture_t") return Role::kV;
+  if (name == "red" || name == "r" || name == "diffuse_red") return Role::kRed;
+  if (name == "green" || name == "g" || name == "diffuse_green") return Role::kGreen;
+  if (name == "blue" || name == "b" || name == "diffuse_blue") return Role::kBlue;
+  if (name == "alpha" || name == "a" || name == "diffuse_alpha") return Role::kAlpha;
   return Role::kSkip;
 }
 
@@ -486,12 +520,13 @@ class PlyBuilder {
   BodyReader& body_;
   Mesh mesh_;
   uint64_t vertex_count_ = 0;
-  bool has_normals_ = false, has_uvs_ = false;
+  bool has_normals_ = false, has_uvs_ = false, has_colors_ = false;
   std::vector<uint32_t> corners_;
 };
 
 bool PlyBuilder::read_vertex(const Element& e, size_t index) {
-  float v[10] = {};  // by Role
+  float v[int(Role::kIndices)] = {};  // by Role
+  v[int(Role::kAlpha)] = 1.0f;        // opaque unless the file says otherwise
   for (const Property& p : e.properties) {
     double value = 0.0;
     if (p.list) {
@@ -509,12 +544,17 @@ bool PlyBuilder::read_vertex(const Element& e, size_t index) {
     if (!(std::fabs(value) <= double(std::numeric_limits<float>::max()))) {
       return body_.fail("property '" + p.name + "' is not finite as a 32-bit float");
     }
+    if (p.role >= Role::kRed && p.role <= Role::kAlpha) value = colour_channel(p.type, value);
     v[int(p.role)] = float(value);
   }
   mesh_.positions[index] = {v[int(Role::kX)], v[int(Role::kY)], v[int(Role::kZ)]};
   if (has_normals_)
     mesh_.normals[index] = {v[int(Role::kNx)], v[int(Role::kNy)], v[int(Role::kNz)]};
   if (has_uvs_) mesh_.uvs[index] = {v[int(Role::kU)], v[int(Role::kV)]};
+  if (has_colors_) {
+    mesh_.colors[index] = {v[int(Role::kRed)], v[int(Role::kGreen)], v[int(Role::kBlue)],
+                           v[int(Role::kAlpha)]};
+  }
   return true;
 }
 
@@ -589,17 +629,19 @@ Result<Mesh> PlyBuilder::build() {
     if (e.name == "vertex") vertices = &e;
   }
   if (!vertices) return fail(name_, "no 'vertex' element");
-  int xyz = 0, normals = 0, uvs = 0;
+  int xyz = 0, normals = 0, uvs = 0, colors = 0;
   for (const Property& p : vertices->properties) {
     xyz += p.role == Role::kX || p.role == Role::kY || p.role == Role::kZ;
     normals += p.role == Role::kNx || p.role == Role::kNy || p.role == Role::kNz;
     uvs += p.role == Role::kU || p.role == Role::kV;
+    colors += p.role == Role::kRed || p.role == Role::kGreen || p.role == Role::kBlue;
   }
   if (xyz != 3) return fail(name_, "the vertex element lacks x, y or z");
   if (vertices->count > UINT32_MAX) return fail(name_, "more than 2^32 - 1 vertices");
   vertex_count_ = vertices->count;
   has_normals_ = normals == 3;
   has_uvs_ = uvs == 2;
+  has_colors_ = colors == 3;  // red, green and blue; alpha optional
   // The vertex arrays, once the count is known to fit in the bytes left.
   uint64_t need = min_element_bytes(*vertices, body_.ascii());
   if (vertex_count_ > (body_.remaining()) / need) {
@@ -611,6 +653,7 @@ Result<Mesh> PlyBuilder::build() {
   mesh_.positions.resize(size_t(vertex_count_));
   mesh_.uvs.resize(size_t(vertex_count_), glm::vec2(0.0f));
   if (has_normals_) mesh_.normals.resize(size_t(vertex_count_));
+  if (has_colors_) mesh_.colors.resize(size_t(vertex_count_));
   for (const Element& e : h_.elements) {
     if (Status s = read_element(e); !s.ok()) return s;
   }

@@ -57,6 +57,23 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_with_derivatives(const Texture& t, con
   return sample<N>(t, s, uv, {f.ddx(uv.x), f.ddx(uv.y)}, {f.ddy(uv.x), f.ddy(uv.y)});
 }
 
+// Where a shader takes a vertex's albedo from: the mesh's vertex colours (OBJ, PLY), when it has
+// them and `use` is set, else the material's. Vertex colours are display values, as texels are:
+// decoded from sRGB in the linear workflow (`decode`), as textures are.
+struct ColorSource {
+  bool use = false;
+  bool decode = false;
+  glm::vec3 albedo(const Mesh& mesh, uint32_t i, const glm::vec3& fallback) const {
+    if (!use) return fallback;
+    glm::vec3 c(mesh.colors[i]);
+    if (!decode) return c;
+    auto linear = [](float x) {
+      return x <= 0.04045f ? x / 12.92f : std::pow((x + 0.055f) / 1.055f, 2.4f);
+    };
+    return {linear(c.r), linear(c.g), linear(c.b)};
+  }
+};
+
 struct FlatShader {
   static constexpr int kVaryings = 0;
   static constexpr bool kCheapToShade = true;  // a constant colour (see GouraudShader)
@@ -87,16 +104,18 @@ struct GouraudShader {
   glm::vec3 albedo;
   Lighting lighting;
   float alpha = 1.0f;
-  glm::vec3 lit(const glm::vec3& n) const {
+  ColorSource colors;  // the mesh's vertex colours as the albedo, when it has them
+  glm::vec3 lit(const glm::vec3& n, const glm::vec3& base) const {
     float d = std::max(glm::dot(n, lighting.light), 0.0f);
-    return albedo * (lighting.ambient + lighting.diffuse * d);
+    return base * (lighting.ambient + lighting.diffuse * d);
   }
   glm::vec4 vertex(uint32_t i, float* v) const {
     glm::vec3 n = glm::normalize(in.mesh->normals[i]);
-    glm::vec3 c = lit(n);
+    glm::vec3 base = colors.albedo(*in.mesh, i, albedo);
+    glm::vec3 c = lit(n, base);
     v[0] = c.r, v[1] = c.g, v[2] = c.b;
     if constexpr (kTwoSided) {
-      glm::vec3 back = lit(-n);
+      glm::vec3 back = lit(-n, base);
       v[3] = back.r, v[4] = back.g, v[5] = back.b;
     }
     return in.clip(i);
@@ -149,8 +168,9 @@ struct SurfaceMaps {
 };
 
 // What a Phong draw interpolates besides world position and normal: nothing (no maps), the
-// texture coordinates (maps), or those and the tangent frame (a tangent-space normal map).
-enum class PhongInputs { kPlain, kUv, kTangentFrame };
+// texture coordinates (maps), those and the tangent frame (a tangent-space normal map), or the
+// vertex colours as the albedo (no maps).
+enum class PhongInputs { kPlain, kUv, kTangentFrame, kColors };
 
 // Blinn-Phong per pixel with a material's maps: albedo from the diffuse map, specular colour
 // times the specular map, the normal from a normal map (object space, or tangent space with
@@ -160,9 +180,11 @@ enum class PhongInputs { kPlain, kUv, kTangentFrame };
 // and to interpolate per block, the same image.
 template <PhongInputs kInputs>
 struct PhongShader {
-  static constexpr bool kUv = kInputs != PhongInputs::kPlain;
+  static constexpr bool kUv = kInputs == PhongInputs::kUv || kInputs == PhongInputs::kTangentFrame;
   static constexpr bool kTangents = kInputs == PhongInputs::kTangentFrame;
-  static constexpr int kVaryings = kTangents ? 12 : kUv ? 8 : 6;  // position, normal (uv, tangent)
+  static constexpr bool kColors = kInputs == PhongInputs::kColors;
+  // position, normal (uv, tangent; or colour)
+  static constexpr int kVaryings = kTangents ? 12 : kUv ? 8 : kColors ? 9 : 6;
   MeshInputs in;
   glm::vec3 albedo;
   SurfaceMaps maps;
@@ -170,6 +192,7 @@ struct PhongShader {
   Lighting lighting;
   glm::vec3 eye;
   float alpha = 1.0f;
+  ColorSource colors;  // kColors: the vertex colours (decoded as textures are)
   // Only the maps' trilinear lookups read derivatives (shadows and lighting do not).
   bool reads_derivatives() const { return kUv && sampler.filter == Filter::kTrilinear; }
   glm::vec4 vertex(uint32_t i, float* v) const {
@@ -183,6 +206,10 @@ struct PhongShader {
     if constexpr (kTangents) {
       const glm::vec4& t = in.mesh->tangents[i];
       v[8] = t.x, v[9] = t.y, v[10] = t.z, v[11] = t.w;
+    }
+    if constexpr (kColors) {
+      glm::vec3 c = colors.albedo(*in.mesh, i, albedo);
+      v[6] = c.r, v[7] = c.g, v[8] = c.b;
     }
     return in.clip(i);
   }
@@ -216,6 +243,7 @@ struct PhongShader {
                                      : simd::splat3<N>(lighting.light);
     LightTerms<N> light = blinn_phong<N>(n, l, view, maps.shininess);
     simd::Vec4<N> base{F(albedo.r), F(albedo.g), F(albedo.b), F(1.0f)};
+    if constexpr (kColors) base = {f.varying(6), f.varying(7), f.varying(8), F(1.0f)};
     simd::Vec3<N> ks = simd::splat3<N>(maps.specular_color);
     F a = F(alpha * maps.opacity);
     if constexpr (kUv) {

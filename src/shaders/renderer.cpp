@@ -105,19 +105,27 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
   static const Texture kWhite;  // samples as opaque white
   Sampler sampler = opt.sampler;
   sampler.srgb_decode = opt.srgb;
+  // Vertex colours (OBJ, PLY) are the albedo of flat, gouraud and phong where no diffuse map is.
+  ColorSource colors{mesh.colors.size() == mesh.positions.size() && !surf.maps.diffuse, opt.srgb};
   switch (kind) {
     case ShaderKind::kFlat:
+      if (colors.use) {  // unlit, interpolated: Gouraud with the ambient term alone, at 1
+        Lighting unlit = lighting;
+        unlit.ambient = 1.0f, unlit.diffuse = 0.0f;
+        return draw(fb, state, GouraudShader<false>{in, surf.albedo, unlit, opt.alpha, colors},
+                    indices, n);
+      }
       return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, opt.alpha), opt.srgb}, indices,
                   n);
     case ShaderKind::kWireframe:  // the overlay passes the wire colour as the surface albedo
       return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, 1.0f)}, indices, n);
     case ShaderKind::kGouraud:
       if (two_sided) {
-        return draw(fb, state, GouraudShader<true>{in, surf.albedo, lighting, opt.alpha}, indices,
-                    n);
+        return draw(fb, state, GouraudShader<true>{in, surf.albedo, lighting, opt.alpha, colors},
+                    indices, n);
       }
-      return draw(fb, state, GouraudShader<false>{in, surf.albedo, lighting, opt.alpha}, indices,
-                  n);
+      return draw(fb, state, GouraudShader<false>{in, surf.albedo, lighting, opt.alpha, colors},
+                  indices, n);
     case ShaderKind::kTexture: {
       const Texture* t = surf.texture ? surf.texture : &kWhite;
       return draw(fb, state, TextureShader{in, t, sampler, opt.alpha, opt.srgb}, indices, n);
@@ -128,20 +136,26 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
       bool tangents = maps.normal && !maps.object_space;
       if (tangents && mesh.tangents.size() == mesh.positions.size()) {
         return draw(fb, state,
-                    PhongShader<PhongInputs::kTangentFrame>{in, surf.albedo, maps, sampler,
-                                                            lighting, camera.eye, opt.alpha},
+                    PhongShader<PhongInputs::kTangentFrame>{
+                        in, surf.albedo, maps, sampler, lighting, camera.eye, opt.alpha, {}},
                     indices, n);
       }
       if (tangents) maps.normal = nullptr;  // no tangent frame: the interpolated normal
       if (maps.diffuse || maps.specular || maps.normal || maps.alpha) {
         return draw(fb, state,
-                    PhongShader<PhongInputs::kUv>{in, surf.albedo, maps, sampler, lighting,
-                                                  camera.eye, opt.alpha},
+                    PhongShader<PhongInputs::kUv>{
+                        in, surf.albedo, maps, sampler, lighting, camera.eye, opt.alpha, {}},
+                    indices, n);
+      }
+      if (colors.use) {
+        return draw(fb, state,
+                    PhongShader<PhongInputs::kColors>{in, surf.albedo, maps, sampler, lighting,
+                                                      camera.eye, opt.alpha, colors},
                     indices, n);
       }
       return draw(fb, state,
-                  PhongShader<PhongInputs::kPlain>{in, surf.albedo, maps, sampler, lighting,
-                                                   camera.eye, opt.alpha},
+                  PhongShader<PhongInputs::kPlain>{
+                      in, surf.albedo, maps, sampler, lighting, camera.eye, opt.alpha, {}},
                   indices, n);
     }
     case ShaderKind::kNormals:
