@@ -581,6 +581,29 @@ TEST_F(ScriptTest, InfoReportsGeometryMaterialsAndMaps) {
   }
 }
 
+// info resolves the files a model names as the render does (find_referenced_file): a map name
+// after options and with a space, Windows separators and another case; one from another
+// machine's folder, found beside the material.
+TEST_F(ScriptTest, InfoResolvesMapsAsTheRenderDoes) {
+  fs::create_directories(work() / "tex");
+  write(work() / "tex" / "my tex.png", "x");
+  write(work() / "spec.png", "x");
+  write(work() / "m.mtl",
+        "newmtl a\nmap_Kd -s 2 2 1 -clamp on TEX\\My Tex.PNG\nmap_Ks C:\\art\\spec.png\n");
+  write(work() / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+  Outcome r = run("info m.obj --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  json info = json::parse(lines_of(r.out).at(0));
+  json maps = info["materials"][0]["maps"];
+  ASSERT_EQ(maps.size(), 2u) << r.out;
+  EXPECT_EQ(maps[0]["path"], "TEX\\My Tex.PNG");
+  EXPECT_EQ(maps[0]["found"], true);
+  EXPECT_EQ(fs::path(maps[0]["resolved"].get<std::string>()).filename(), "my tex.png");
+  EXPECT_EQ(maps[1]["path"], "C:\\art\\spec.png");
+  EXPECT_EQ(maps[1]["found"], true);
+  EXPECT_EQ(fs::path(maps[1]["resolved"].get<std::string>()).filename(), "spec.png");
+}
+
 TEST_F(ScriptTest, InfoOnABrokenModelSaysWhyAndStillListsItsFiles) {
   write(work() / "broken.mtl", "newmtl skin\nmap_Kd skin.png\n");
   write(work() / "broken.obj",

@@ -6,6 +6,7 @@
 #include "info.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -78,6 +79,30 @@ bool is_map(std::string_view keyword) {
          keyword == "decal" || keyword == "refl" || keyword == "norm";
 }
 
+// The file a map statement names: what follows its options (-s 1 1 1, -clamp on, ...), spaces
+// kept, as tinyobj (and so the render) reads it.
+std::string map_file(const std::vector<std::string_view>& w) {
+  auto number = [](std::string_view word) {
+    double d = 0.0;
+    auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), d);
+    return ec == std::errc() && end == word.data() + word.size();
+  };
+  size_t i = 1;
+  while (i < w.size() && w[i].size() > 1 && w[i][0] == '-') {
+    std::string_view option = w[i++];
+    if (option == "-o" || option == "-s" || option == "-t") {  // one to three numbers
+      for (int k = 0; k < 3 && i < w.size() && number(w[i]); ++k) ++i;
+    } else if (option == "-mm") {
+      i += 2;
+    } else {  // -blendu, -blendv, -boost, -cc, -clamp, -imfchan, -texres, -bm, -type: one word
+      ++i;
+    }
+  }
+  std::string file;
+  for (; i < w.size(); ++i) file.append(file.empty() ? "" : " ").append(w[i]);
+  return file;
+}
+
 void scan_library(const Reference& library, Scan& scan) {
   std::ifstream in(library.resolved);
   std::string line;
@@ -86,7 +111,7 @@ void scan_library(const Reference& library, Scan& scan) {
     std::vector<std::string_view> w = words_of(line);
     if (w.size() >= 2 && w[0] == "newmtl") scan.materials.push_back({std::string(w[1]), {}});
     if (w.size() >= 2 && is_map(w[0]) && !scan.materials.empty()) {
-      scan.materials.back().maps.push_back(reference(std::string(w[0]), w.back(), folder));
+      scan.materials.back().maps.push_back(reference(std::string(w[0]), map_file(w), folder));
     }
   }
 }
