@@ -6,7 +6,8 @@
 //      each chunk (one thread at a time) trivially accepts triangles whose three vertices are
 //      inside the clip volume (guard band, near, far) and clips the others, culls by the snapped
 //      area, sets up a compact record (triangle_record.hpp) in the chunk's arena and appends its
-//      offset to the bin of every tile its bounds touch.
+//      offset to the bin of every tile its bounds touch. At AVX2 and AVX-512 the accept, the cull
+//      and the coverage (edges, bounds) take 8 or 16 triangles at once (triangle_kernels.hpp).
 //   2. Raster: each tile (one thread at a time) walks the bins of all chunks in chunk order, so
 //      every pixel sees its triangles in submission order and blending stays order-correct; the
 //      tile is the raster region, so no two threads ever touch the same pixel. Deferrable draws
@@ -31,6 +32,7 @@
 #include "pipeline/draw_internal.hpp"
 #include "pipeline/tile_kernels.hpp"
 #include "pipeline/tile_visibility.hpp"
+#include "pipeline/triangle_kernels.hpp"
 #include "pipeline/triangle_record.hpp"
 #include "softrast/detail/parallel.hpp"
 #include "softrast/framebuffer.hpp"
@@ -105,6 +107,7 @@ class BinnedDraw {
         cache_(draw_cache()) {
     deferred_ = deferred_shading_applies(state, program);
     kernels_ = tile_kernels(simd_level());
+    triangle_kernel_ = triangle_kernel(simd_level());
     record_bytes_ = record_bytes(geometry.num_varyings());
     const PixelRect& s = geometry.scissor();
     tiles_x_ = (s.x1 + kTileSize - 1) / kTileSize;
@@ -149,9 +152,54 @@ class BinnedDraw {
       add_triangle(chunk, a, b, c);
     };
     auto keep = [&](int64_t area) { return kept(area); };
-    for (size_t t = begin; t < end; ++t) {
-      cache_.vertices.triangle(geometry_, indices + 3 * t, keep, add);
+    const WindowVertices& vertices = cache_.vertices;
+    // The SIMD kernel takes groups of triangles (triangle_kernels.hpp); the triangles it leaves to
+    // the scalar path go there in their place, so the records keep submission order.
+    const size_t n = vertices.size();
+    if (triangle_kernel_.fn != nullptr && n != 0 && n < (size_t(1) << 31) / 6) {
+      TriangleBatch batch;
+      batch.indices = indices;
+      batch.vertex_count = n;
+      batch.window = vertices.window();
+      batch.cull = state_.cull;
+      batch.front_face = state_.front_face;
+      batch.scissor = geometry_.scissor();
+      TriangleLanes lanes;
+      const size_t width = size_t(triangle_kernel_.lanes);
+      for (size_t t = begin; t < end; t += width) {
+        triangle_kernel_.fn(batch, t, int(std::min(width, end - t)), lanes);
+        for (uint32_t todo = lanes.ready | lanes.scalar; todo != 0; todo &= todo - 1) {
+          int l = __builtin_ctz(todo);
+          if ((lanes.scalar >> l) & 1u) {
+            vertices.triangle(geometry_, indices + 3 * (t + size_t(l)), keep, add);
+          } else {
+            add_set_up(chunk, lanes, l);
+          }
+        }
+      }
+      return;
     }
+    for (size_t t = begin; t < end; ++t) vertices.triangle(geometry_, indices + 3 * t, keep, add);
+  }
+
+  // A triangle that the SIMD kernel set up (lane l): its record, as add_triangle makes it.
+  void add_set_up(Chunk& chunk, const TriangleLanes& lanes, int l) {
+    uint32_t offset = chunk.records.allocate(record_bytes_);
+    TriRecord* rec = chunk.records.at(offset);  // every field is written below
+    TriangleCoverage& t = rec->coverage;
+    WindowVertex v[3];
+    for (int k = 0; k < 3; ++k) {
+      t.vx[k] = lanes.x[k][l];
+      t.vy[k] = lanes.y[k][l];
+      t.edge[k] = {lanes.edge_a[k][l], lanes.edge_b[k][l], lanes.edge_c[k][l]};
+      v[k] = cache_.vertices.vertex(geometry_, lanes.vertex[k][l]);
+    }
+    t.bounds = {lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l], lanes.bounds[3][l]};
+    rec->small = (lanes.small >> l) & 1u;
+    const WindowVertex* ordered[3] = {&v[0], &v[1], &v[2]};
+    setup_triangle_interpolants(ordered, geometry_.num_varyings(), lanes.area[l], state_.front_face,
+                                rec->interp());
+    bin(chunk, t.bounds, offset);
   }
 
   // Whether a triangle of snapped signed area `area` survives culling (zero area never does).
@@ -346,6 +394,7 @@ class BinnedDraw {
   DrawCache& cache_;
   bool deferred_ = false;
   TileKernels kernels_{};
+  TriangleKernel triangle_kernel_{};
   size_t record_bytes_ = 0;
   size_t num_chunks_ = 1;
   int tiles_x_ = 0, tiles_y_ = 0;

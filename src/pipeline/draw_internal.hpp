@@ -84,11 +84,16 @@ class WindowVertices {
     }
   }
 
- private:
+  // Vertex i as a WindowVertex; precondition: its code is 0.
   WindowVertex vertex(const GeometryStage& geometry, uint32_t i) const {
     const PackedVertex& p = window_[i];
     return {p.x, p.y, p.z, p.inv_w, geometry.varyings(i), p.x_residual, p.y_residual};
   }
+  // Every vertex's PackedVertex (kOutsideVolume in x where its code is not 0), and their number.
+  const PackedVertex* window() const { return window_.data(); }
+  size_t size() const { return window_.size(); }
+
+ private:
   std::vector<PackedVertex> window_;
   std::vector<uint8_t> codes_;  // GeometryStage::vertex_code
 };

@@ -119,6 +119,8 @@ void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
     typedef float FN __attribute__((vector_size(4 * kD)));
     typedef int32_t IN __attribute__((vector_size(4 * kD)));
     IN xi = __builtin_convertvector(wx, IN), yi = __builtin_convertvector(wy, IN);
+    const IN outside = __builtin_convertvector(code != 0, IN);  // PackedVertex: kOutsideVolume
+    xi = outside ? IN{} + kOutsideVolume : xi;
     FN zf = __builtin_convertvector(wz, FN), wf = __builtin_convertvector(inv_w, FN);
     FN rxf = __builtin_convertvector(rx, FN), ryf = __builtin_convertvector(ry, FN);
     if (b.depth_bias != 0.0f) {  // geometry_stage.hpp: the depth bias, in float

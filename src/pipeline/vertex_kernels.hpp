@@ -15,7 +15,11 @@
 
 namespace softrast::detail {
 
-// A vertex in window space: WindowVertex without the varyings pointer.
+// A vertex in window space: WindowVertex without the varyings pointer. Where the vertex's code is
+// not 0 (outside the clip volume, or NaN), only x is set: kOutsideVolume, which no snapped
+// coordinate equals (|x| < kMaxCoordFx8), so that the triangle kernels find the triangles that
+// are not trivially accepted from the positions alone.
+inline constexpr int32_t kOutsideVolume = INT32_MIN;
 struct PackedVertex {
   int32_t x, y;  // 1/256 pixel
   float z, inv_w;
@@ -29,7 +33,7 @@ struct VertexBatch {
   int width = 1, height = 1;            // Viewport
   float depth_bias = 0.0f;              // RenderState::depth_bias
   uint8_t* codes = nullptr;             // out: GeometryStage::vertex_code
-  PackedVertex* window = nullptr;       // out: the window vertex where the code is 0
+  PackedVertex* window = nullptr;       // out: the window vertex (PackedVertex)
 };
 
 // Transforms vertices [begin, end) of the batch.

@@ -1,0 +1,63 @@
+// pipeline/triangle_kernels.hpp: the binned draw's triangle assembly, culling and coverage setup
+// in SIMD, across several triangles at once (8 at AVX2, 16 at AVX-512; the SSE levels keep the
+// scalar path). One source (triangle_kernel.inl) compiled per instruction set.
+//
+// For each triangle of a group it finds what the scalar front end would do with it: nothing
+// (an index out of range, culled, zero area, no pixel inside the scissor), the scalar path (a
+// vertex outside the clip volume: clipping, or a NaN), or a set-up triangle, whose coverage it
+// computes: the vertices in clockwise order, the pixel bounds inside the scissor, the edge
+// functions with the fill rule and the 32-bit flag. Bit for bit what setup_triangle_coverage
+// computes (tests/triangle_kernel_test.cpp): every quantity is an integer, and the products and
+// sums of 16.8 coordinates are exact in double (below 2^49, fixed_point.hpp), so they are
+// computed in double lanes and converted back exactly.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "pipeline/vertex_kernels.hpp"
+#include "raster/setup.hpp"
+#include "softrast/render_state.hpp"
+#include "softrast/simd_level.hpp"
+
+namespace softrast::detail {
+
+// The triangles of one draw as the kernel reads them.
+struct TriangleBatch {
+  const uint32_t* indices = nullptr;     // three per triangle
+  size_t vertex_count = 0;               // indices at or past it skip their triangle
+  const PackedVertex* window = nullptr;  // x is kOutsideVolume where the vertex code is not 0
+  CullMode cull = CullMode::kNone;
+  FrontFace front_face = FrontFace::kCounterClockwise;
+  PixelRect scissor;
+};
+
+// One group's results, lane l for triangle first + l. Bit l of `ready` marks a triangle set up
+// here (the arrays below hold its coverage), of `scalar` one for the scalar path; a lane in
+// neither draws nothing.
+struct TriangleLanes {
+  static constexpr int kMaxLanes = 16;
+  uint32_t ready = 0;
+  uint32_t scalar = 0;
+  uint32_t small = 0;                         // TriRecord::small, for ready lanes
+  alignas(64) uint32_t vertex[3][kMaxLanes];  // vertex indices, clockwise
+  alignas(64) int32_t x[3][kMaxLanes];        // TriangleCoverage::vx
+  alignas(64) int32_t y[3][kMaxLanes];        // TriangleCoverage::vy
+  alignas(64) int32_t edge_a[3][kMaxLanes];   // EdgeFunction::a (|a| < 2^24)
+  alignas(64) int32_t edge_b[3][kMaxLanes];   // EdgeFunction::b
+  alignas(64) int64_t edge_c[3][kMaxLanes];   // EdgeFunction::c
+  alignas(64) int64_t area[kMaxLanes];        // signed_area_fx16 of the triangle as submitted
+  alignas(64) int32_t bounds[4][kMaxLanes];   // x0, y0, x1, y1 (PixelRect)
+};
+
+// Sets up triangles [first, first + count) of the batch, count <= the kernel's lanes.
+// Preconditions: batch.vertex_count >= 1 and 6 * vertex_count < 2^31.
+using TriangleKernelFn = void (*)(const TriangleBatch& batch, size_t first, int count,
+                                  TriangleLanes& out);
+struct TriangleKernel {
+  TriangleKernelFn fn = nullptr;  // null at the SSE levels: the scalar path
+  int lanes = 0;
+};
+TriangleKernel triangle_kernel(SimdLevel level);
+
+}  // namespace softrast::detail

@@ -1,0 +1,249 @@
+// The SIMD triangle kernels (pipeline/triangle_kernels.hpp) at every level this CPU has, against
+// the scalar front end they replace: for every triangle of a group, the same decision (nothing,
+// the scalar path, or set up) as WindowVertices::triangle, culling and setup_triangle_coverage
+// make, and for a set-up triangle the same coverage, bit for bit: clockwise vertices, edge
+// functions with the fill rule, bounds inside the scissor, the 32-bit flag and the signed area.
+// Then whole draws with culling through the binned path at every level against the reference
+// path.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "pipeline/draw_internal.hpp"
+#include "pipeline/triangle_kernels.hpp"
+#include "softrast/renderer.hpp"
+#include "softrast/shader.hpp"
+
+namespace softrast {
+namespace {
+
+// Clip-space vertices (x, y, z, w, one varying): mostly inside the view, and some of each kind
+// the front end treats apart: beyond the guard band, behind the eye, NaN and Inf, exactly on
+// planes, snapped onto the same point (zero area), and triangles larger than the 32-bit path's.
+std::vector<float> kernel_vertices(int count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<float> v;
+  for (int i = 0; i < count; ++i) {
+    float w = 0.2f + 2.0f * std::abs(unit(rng));
+    // Clustered: neighbouring vertices are near each other, so most triangles are small.
+    float cx = 0.9f * std::sin(float(i / 16)), cy = 0.9f * std::cos(float(i / 16) * 1.7f);
+    float spread = (i / 64) % 3 == 0 ? 0.9f : 0.01f;
+    float p[5] = {(cx + spread * unit(rng)) * w, (cy + spread * unit(rng)) * w, unit(rng) * w, w,
+                  unit(rng)};
+    switch (i % 29) {
+      case 1:
+        p[0] *= 5000.0f;  // beyond the guard band
+        break;
+      case 2:
+        p[3] = -p[3];  // behind the eye
+        break;
+      case 3:
+        p[1] = nan;
+        break;
+      case 4:
+        p[2] = p[3];  // on the far plane: inside
+        break;
+      case 5:
+        p[0] = p[1] = 0.0f;  // the image centre: shared by every vertex of this kind
+        break;
+      case 6:
+        p[1] = std::numeric_limits<float>::infinity();
+        break;
+      default:
+        break;
+    }
+    v.insert(v.end(), p, p + 5);
+  }
+  return v;
+}
+
+TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
+  const int kVertices = 3000;
+  std::vector<float> data = kernel_vertices(kVertices, 11);
+  detail::ClipVertices clip{data.data(), size_t(kVertices), 5, 1};
+  // Triangles of nearby vertices, a few far apart, and indices out of range.
+  std::mt19937 rng(5);
+  std::vector<uint32_t> indices;
+  const int kTriangles = 20000;
+  for (int t = 0; t < kTriangles; ++t) {
+    uint32_t base = uint32_t(rng() % (kVertices - 8));
+    for (int k = 0; k < 3; ++k) {
+      uint32_t i = base + uint32_t(rng() % 8);
+      if (t % 41 == 7 && k == 1) i = uint32_t(rng() % kVertices);
+      if (t % 97 == 3 && k == 2) i = kVertices + uint32_t(rng() % 3);  // out of range
+      if (t % 89 == 5) i = base;                                       // all three the same
+      indices.push_back(i);
+    }
+  }
+  int checked_ready = 0, checked_scalar = 0, checked_none = 0;
+  for (SimdLevel level : {SimdLevel::kAvx2, SimdLevel::kAvx512}) {
+    if (cpu_simd_level() < level) continue;
+    const detail::TriangleKernel kernel = detail::triangle_kernel(level);
+    ASSERT_NE(kernel.fn, nullptr);
+    for (int size : {64, 1920}) {
+      RenderState state;
+      detail::GeometryStage geometry(size, size * 9 / 16 + 1, state, clip);
+      detail::WindowVertices vertices;
+      vertices.transform(geometry, 1);
+      for (CullMode cull : {CullMode::kNone, CullMode::kBack, CullMode::kFront}) {
+        for (FrontFace face : {FrontFace::kCounterClockwise, FrontFace::kClockwise}) {
+          for (detail::PixelRect scissor :
+               {geometry.scissor(), detail::PixelRect{5, 3, size / 2, size / 3}}) {
+            detail::TriangleBatch batch;
+            batch.indices = indices.data();
+            batch.vertex_count = vertices.size();
+            batch.window = vertices.window();
+            batch.cull = cull;
+            batch.front_face = face;
+            batch.scissor = scissor;
+            // Groups at every offset modulo the width, and short ones.
+            for (size_t first = 0; first < size_t(kTriangles);) {
+              int count = int(std::min<size_t>(kernel.lanes - (first % 3 == 0 ? first % 5 : 0),
+                                               kTriangles - first));
+              detail::TriangleLanes lanes;
+              kernel.fn(batch, first, count, lanes);
+              for (int l = 0; l < kernel.lanes; ++l) {
+                const bool ready = (lanes.ready >> l) & 1u, scalar = (lanes.scalar >> l) & 1u;
+                SCOPED_TRACE(::testing::Message()
+                             << "level " << int(level) << " triangle " << first + size_t(l)
+                             << " cull " << int(cull) << " face " << int(face));
+                if (l >= count) {
+                  EXPECT_FALSE(ready || scalar);
+                  continue;
+                }
+                const uint32_t* tri = indices.data() + 3 * (first + size_t(l));
+                if (!geometry.valid(tri[0]) || !geometry.valid(tri[1]) || !geometry.valid(tri[2])) {
+                  EXPECT_FALSE(ready || scalar);
+                  ++checked_none;
+                  continue;
+                }
+                if ((geometry.vertex_code(tri[0]) | geometry.vertex_code(tri[1]) |
+                     geometry.vertex_code(tri[2])) != 0) {
+                  EXPECT_TRUE(scalar && !ready);
+                  ++checked_scalar;
+                  continue;
+                }
+                EXPECT_FALSE(scalar);
+                detail::WindowVertex v[3] = {vertices.vertex(geometry, tri[0]),
+                                             vertices.vertex(geometry, tri[1]),
+                                             vertices.vertex(geometry, tri[2])};
+                int64_t area = detail::signed_area_fx16(v[0], v[1], v[2]);
+                detail::TriangleCoverage want;
+                const detail::WindowVertex* ordered[3];
+                bool set_up =
+                    area != 0 && !detail::is_culled(area, cull, face) &&
+                    detail::setup_triangle_coverage(v[0], v[1], v[2], area, scissor, want, ordered);
+                ASSERT_EQ(ready, set_up);
+                if (!set_up) {
+                  ++checked_none;
+                  continue;
+                }
+                ++checked_ready;
+                EXPECT_EQ(lanes.area[l], area);
+                for (int k = 0; k < 3; ++k) {
+                  EXPECT_EQ(lanes.x[k][l], want.vx[k]);
+                  EXPECT_EQ(lanes.y[k][l], want.vy[k]);
+                  EXPECT_EQ(vertices.vertex(geometry, lanes.vertex[k][l]).x, ordered[k]->x);
+                  EXPECT_EQ(vertices.vertex(geometry, lanes.vertex[k][l]).y, ordered[k]->y);
+                  EXPECT_EQ(lanes.edge_a[k][l], want.edge[k].a);
+                  EXPECT_EQ(lanes.edge_b[k][l], want.edge[k].b);
+                  EXPECT_EQ(lanes.edge_c[k][l], want.edge[k].c);
+                }
+                EXPECT_EQ(lanes.bounds[0][l], want.bounds.x0);
+                EXPECT_EQ(lanes.bounds[1][l], want.bounds.y0);
+                EXPECT_EQ(lanes.bounds[2][l], want.bounds.x1);
+                EXPECT_EQ(lanes.bounds[3][l], want.bounds.y1);
+                auto extent = [](const int32_t c[3]) {
+                  return int64_t(std::max({c[0], c[1], c[2]})) - std::min({c[0], c[1], c[2]});
+                };
+                bool small = extent(want.vx) <= detail::kSmallTriangleFx8 &&
+                             extent(want.vy) <= detail::kSmallTriangleFx8;
+                EXPECT_EQ(bool((lanes.small >> l) & 1u), small);
+                if (::testing::Test::HasFailure()) return;
+              }
+              first += size_t(count);
+            }
+          }
+        }
+      }
+    }
+  }
+  if (cpu_simd_level() < SimdLevel::kAvx2) GTEST_SKIP() << "no AVX2 on this CPU";
+  // Every outcome was reached, many times.
+  EXPECT_GT(checked_ready, 10000);
+  EXPECT_GT(checked_scalar, 1000);
+  EXPECT_GT(checked_none, 10000);
+}
+
+// Flat-coloured triangles of both facings, some crossing the near plane and the image border,
+// through the binned path at every level, against the reference path: culling of either facing
+// with either winding as front, the same image bit for bit.
+struct FacingShader {
+  static constexpr int kVaryings = 3;
+  const glm::vec4* positions;
+  const glm::vec3* colors;
+  glm::vec4 vertex(uint32_t i, float* v) const {
+    v[0] = colors[i].r, v[1] = colors[i].g, v[2] = colors[i].b;
+    return positions[i];
+  }
+  bool fragment(FragmentInput& in, glm::vec4& out) const {
+    out = glm::vec4(in.vec3(0), 1.0f);
+    return true;
+  }
+};
+
+TEST(TriangleKernel, CulledDrawsMatchTheReferencePathAtEveryLevel) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<float> pos(-1.3f, 1.3f), unit(0.0f, 1.0f), size(0.005f, 0.3f);
+  std::vector<glm::vec4> positions;
+  std::vector<glm::vec3> colors;
+  std::vector<uint32_t> indices;
+  for (int t = 0; t < 30000; ++t) {
+    glm::vec2 centre(pos(rng), pos(rng));
+    float s = size(rng);
+    glm::vec3 color(unit(rng), unit(rng), unit(rng));
+    for (int k = 0; k < 3; ++k) {
+      float w = t % 53 == 0 ? -0.2f + unit(rng) : 0.5f + unit(rng);  // some cross w = 0
+      glm::vec2 p = centre + s * glm::vec2(unit(rng) - 0.5f, unit(rng) - 0.5f);
+      positions.push_back(glm::vec4(p * w, (unit(rng) * 1.8f - 0.9f) * w, w));
+      colors.push_back(color);
+      indices.push_back(uint32_t(indices.size()));
+    }
+  }
+  FacingShader shader{positions.data(), colors.data()};
+  const SimdLevel cpu = cpu_simd_level();
+  for (CullMode cull : {CullMode::kBack, CullMode::kFront, CullMode::kNone}) {
+    for (FrontFace face : {FrontFace::kCounterClockwise, FrontFace::kClockwise}) {
+      RenderState state;
+      state.cull = cull;
+      state.front_face = face;
+      auto render = [&](SimdLevel level, bool reference, int threads) {
+        set_simd_level(level);
+        Framebuffer fb(317, 203);
+        RenderState s = state;
+        s.reference_path = reference;
+        s.threads = threads;
+        draw(fb, s, shader, indices, uint32_t(positions.size()));
+        return fb.to_image().rgba;
+      };
+      for (SimdLevel level : {SimdLevel::kSse2, SimdLevel::kAvx2, SimdLevel::kAvx512}) {
+        if (cpu < level) continue;
+        const std::vector<uint8_t> reference = render(level, true, 1);
+        for (int threads : {1, 2}) {
+          EXPECT_TRUE(render(level, false, threads) == reference)
+              << "cull " << int(cull) << " face " << int(face) << " level " << int(level)
+              << " threads " << threads;
+        }
+      }
+      set_simd_level(cpu);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace softrast
