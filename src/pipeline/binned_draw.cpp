@@ -29,6 +29,7 @@
 #include <span>
 #include <vector>
 
+#include "core/prefetch.hpp"
 #include "pipeline/draw_internal.hpp"
 #include "pipeline/tile_kernels.hpp"
 #include "pipeline/tile_visibility.hpp"
@@ -320,15 +321,6 @@ class BinnedDraw {
       prefetch_line(color + line);
       prefetch_line(depth + line);
     }
-  }
-  // PREFETCHT0 written out: GCC 12 drops a loop of __builtin_prefetch here (a function whose only
-  // effect is a prefetch counts as having none, and its inlined call goes with it).
-  static void prefetch_line(const char* p) {
-#if defined(__x86_64__) && defined(__GNUC__)
-    asm volatile("prefetcht0 %0" : : "m"(*p));
-#else
-    __builtin_prefetch(p, 1, 3);
-#endif
   }
 
   // Deferred shading pays for its visibility pass only where triangles overlap: a tile whose

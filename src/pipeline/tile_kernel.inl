@@ -447,11 +447,11 @@ template <Mode kMode>
 // cache, and a tile reads its own among those of its neighbours, so each was a miss to L3 when
 // the raster reached it (spheres_1m: a sixth of the tile kernel's time on the record's first
 // load). Four lines: the coverage and the first planes (a record of three varyings is about 200
-// bytes). PREFETCHT0 written out, as binned_draw.cpp's: GCC may drop __builtin_prefetch.
+// bytes).
 constexpr size_t kRecordPrefetchAhead = 4;
 [[gnu::always_inline]] inline void prefetch_record(const std::byte* record) {
   for (int line = 0; line < 4; ++line) {
-    asm volatile("prefetcht0 %0" : : "m"(*(record + 64 * line)));
+    prefetch_line(record + 64 * line);
   }
 }
 

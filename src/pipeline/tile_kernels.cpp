@@ -4,6 +4,7 @@
 #include "pipeline/tile_kernels.hpp"
 
 #include "core/isa_target.hpp"
+#include "core/prefetch.hpp"
 
 #include <immintrin.h>
 
