@@ -401,9 +401,7 @@ class BinnedDraw {
   }
 
   // The chunks of this draw.
-  std::span<const Chunk> chunks() const {
-    return {cache_.chunks.data(), num_chunks_};
-  }
+  std::span<const Chunk> chunks() const { return {cache_.chunks.data(), num_chunks_}; }
 
   static const TriRecord& record(const Chunk& chunk, uint32_t offset) {
     return *reinterpret_cast<const TriRecord*>(chunk.records.data() + offset);
