@@ -1,5 +1,6 @@
 // Materials and lighting: MTL Kd, Ks, Ns, d and maps (map_Kd, map_Ks, map_d, norm, map_Bump with
-// -bm, a grey bump map as heights), the tutorial models' <model>_*.tga convention, a flat quad
+// -bm, a grey bump map as heights), the maps' placement (-s, -o, -clamp) against uvs moved in
+// the file, the tutorial models' <model>_*.tga convention, a flat quad
 // with a known tangent-space normal map lit as the analytic normal in five orientations (one
 // with mirrored uvs), an object-space map, a point light against its analytic cosine, the
 // default specular keeping the old look, and the CLI's --light-pos, --maps and --srgb.
@@ -211,6 +212,99 @@ Framebuffer render_facing(const Mesh& mesh, glm::vec3 n, const RenderOptions& op
   fb.clear();
   render_mesh(fb, mesh, camera, options);
   return fb;
+}
+
+// The maps' placement options: -s and -o (u and v, with or without v and w) and -clamp, from
+// map_Kd, else from the first map that has any; maps placed differently are a warning; a number
+// out of float's range an error.
+TEST(Materials, MapPlacementOptionsAreRead) {
+  Folder f;
+  f.write("a.obj", std::string("mtllib a.mtl\n") + kQuadObj + "usemtl m\nf 1/1/1 2/2/1 3/3/1\n");
+  f.image("c.png", 2, 2, [](int, int) { return rgba(255, 0, 0); });
+  f.image("s.png", 2, 2, [](int, int) { return rgba(10, 20, 30); });
+  f.write("a.mtl",
+          "newmtl m\nmap_Kd -s 2 3 -o 0.25 -0.5 0 -clamp on c.png\n"
+          "newmtl plain\nmap_Kd c.png\n"
+          "newmtl spec\nmap_Ks -o 0.5 0.75 s.png\n"
+          "newmtl differ\nmap_Kd c.png\nmap_Ks -s 4 4 s.png\n");
+  Result<Mesh> mesh = load_obj(f.path("a.obj"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  ASSERT_EQ(mesh->materials.size(), 4u);
+  const Material& m = mesh->materials[0];
+  EXPECT_EQ(m.uv_scale, glm::vec2(2.0f, 3.0f));
+  EXPECT_EQ(m.uv_offset, glm::vec2(0.25f, -0.5f));
+  EXPECT_TRUE(m.clamp_maps);
+  const Material& plain = mesh->materials[1];
+  EXPECT_EQ(plain.uv_scale, glm::vec2(1.0f));
+  EXPECT_EQ(plain.uv_offset, glm::vec2(0.0f));
+  EXPECT_FALSE(plain.clamp_maps);
+  EXPECT_TRUE(m.diffuse_map);
+  // No map_Kd: the first map with options places them all. (Two numbers: tinyobj alone would
+  // take the file's name for w and lose the map.)
+  EXPECT_EQ(mesh->materials[2].uv_offset, glm::vec2(0.5f, 0.75f));
+  EXPECT_TRUE(mesh->materials[2].specular_map);
+  // map_Kd without options wins over a map_Ks with some; the difference is a warning.
+  EXPECT_EQ(mesh->materials[3].uv_scale, glm::vec2(1.0f));
+  ASSERT_EQ(mesh->warnings.size(), 1u);
+  EXPECT_NE(mesh->warnings[0].find("material 'differ': map_Ks: its -s, -o or -clamp differ from "
+                                   "map_Kd's"),
+            std::string::npos)
+      << mesh->warnings[0];
+  f.write("a.mtl", "newmtl m\nmap_Kd -s 1e999 1 c.png\n");
+  mesh = load_obj(f.path("a.obj"));
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(), f.path("a.mtl") + ":2: number 1e999 is out of range");
+}
+
+// A material's -s and -o move its texture as the same change of the file's uvs does, in every
+// shader that reads maps, and -clamp on clamps it as the clamp-to-edge sampler does: the images
+// are the same bit for bit, and differ from the unplaced texture's.
+TEST(Materials, MapPlacementMovesTheTextureAsTheUvsWould) {
+  Folder f;
+  // 4x4 texels of distinct colours: a repeat or a shift shows.
+  f.image("c.png", 4, 4, [](int x, int y) { return rgba(60 * x + 10, 60 * y + 10, 90); });
+  const std::string faces = "usemtl m\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n";
+  const std::string quad = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\n";
+  // The same quad with uv * (2, 1.5) + (0.25, -0.5) written out: exact in float.
+  f.write("placed.obj", "mtllib placed.mtl\n" + quad + "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n" + faces);
+  f.write("placed.mtl", "newmtl m\nmap_Kd -s 2 1.5 1 -o 0.25 -0.5 0 c.png\n");
+  f.write("moved.obj", "mtllib moved.mtl\n" + quad +
+                           "vt 0.25 -0.5\nvt 2.25 -0.5\nvt 2.25 1\nvt 0.25 1\n" + faces);
+  f.write("moved.mtl", "newmtl m\nmap_Kd c.png\n");
+  f.write("clamped.mtl", "newmtl m\nmap_Kd -s 2 1.5 1 -o 0.25 -0.5 0 -clamp on c.png\n");
+  f.write("clamped.obj",
+          "mtllib clamped.mtl\n" + quad + "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n" + faces);
+  f.write("unplaced.mtl", "newmtl m\nmap_Kd c.png\n");
+  f.write("unplaced.obj",
+          "mtllib unplaced.mtl\n" + quad + "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n" + faces);
+  Result<Mesh> placed = load_obj(f.path("placed.obj")), moved = load_obj(f.path("moved.obj"));
+  Result<Mesh> clamped = load_obj(f.path("clamped.obj"));
+  Result<Mesh> unplaced = load_obj(f.path("unplaced.obj"));
+  ASSERT_TRUE(placed.ok() && moved.ok() && clamped.ok() && unplaced.ok());
+  auto same = [](const Framebuffer& a, const Framebuffer& b) {
+    for (int y = 0; y < a.height(); ++y) {
+      for (int x = 0; x < a.width(); ++x) {
+        if (a.color_at(x, y) != b.color_at(x, y)) return false;
+      }
+    }
+    return true;
+  };
+  for (ShaderKind shader : {ShaderKind::kTexture, ShaderKind::kPhong, ShaderKind::kPbr}) {
+    SCOPED_TRACE(int(shader));
+    RenderOptions options;
+    options.shader = shader;
+    options.state.cull = CullMode::kNone;
+    const glm::vec3 facing(0, 0, 1);
+    Framebuffer a = render_facing(*placed, facing, options);
+    Framebuffer b = render_facing(*moved, facing, options);
+    EXPECT_TRUE(same(a, b)) << "-s and -o should read the texture where the moved uvs do";
+    EXPECT_FALSE(same(a, render_facing(*unplaced, facing, options)));
+    Framebuffer c = render_facing(*clamped, facing, options);
+    EXPECT_FALSE(same(c, b)) << "-clamp on should not repeat the texture";
+    RenderOptions clamping = options;
+    clamping.sampler.wrap_u = clamping.sampler.wrap_v = Wrap::kClampToEdge;
+    EXPECT_TRUE(same(c, render_facing(*moved, facing, clamping)));
+  }
 }
 
 // A flat quad with a constant tangent-space normal map m, in five orientations: rotated in its

@@ -559,6 +559,8 @@ TEST_F(ScriptTest, InfoReportsGeometryMaterialsAndMaps) {
   EXPECT_EQ(red["name"], "red");
   EXPECT_EQ(red["diffuse"], json::parse("[1, 0, 0]"));
   EXPECT_EQ(red["diffuse_map_loaded"], true);
+  EXPECT_EQ(red["uv_scale"], json::parse("[1, 1]"));  // no -s, -o or -clamp: as the file's uvs
+  EXPECT_EQ(red["clamp_maps"], false);
   ASSERT_EQ(red["maps"].size(), 2u);
   EXPECT_EQ(red["maps"][0]["kind"], "map_Kd");
   EXPECT_EQ(red["maps"][0]["path"], "texture.png");
@@ -579,6 +581,7 @@ TEST_F(ScriptTest, InfoReportsGeometryMaterialsAndMaps) {
         "      map_Bump bump.png (MISSING)\n", "    red: 2 triangles\n"}) {
     EXPECT_NE(text.out.find(part), std::string::npos) << "no '" << part << "' in\n" << text.out;
   }
+  EXPECT_EQ(text.out.find("maps placed"), std::string::npos) << text.out;
 }
 
 // info resolves the files a model names as the render does (find_referenced_file): a map name
@@ -602,6 +605,15 @@ TEST_F(ScriptTest, InfoResolvesMapsAsTheRenderDoes) {
   EXPECT_EQ(maps[1]["path"], "C:\\art\\spec.png");
   EXPECT_EQ(maps[1]["found"], true);
   EXPECT_EQ(fs::path(maps[1]["resolved"].get<std::string>()).filename(), "spec.png");
+  // map_Kd's -s and -clamp place every map of the material, and info says so.
+  EXPECT_EQ(info["materials"][0]["uv_scale"], json::parse("[2, 2]"));
+  EXPECT_EQ(info["materials"][0]["uv_offset"], json::parse("[0, 0]"));
+  EXPECT_EQ(info["materials"][0]["clamp_maps"], true);
+  Outcome text = run("info m.obj");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("      maps placed at uv * (2 2) + (0 0), clamped to the edge\n"),
+            std::string::npos)
+      << text.out;
 }
 
 TEST_F(ScriptTest, InfoOnABrokenModelSaysWhyAndStillListsItsFiles) {

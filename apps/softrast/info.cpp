@@ -163,6 +163,12 @@ ojson materials_json(const Scan& scan, const Mesh* mesh) {
     if (const Material* loaded = material_named(mesh, s.name)) {
       m["diffuse"] = vec3_json(loaded->diffuse);
       m["diffuse_map_loaded"] = loaded->diffuse_map != nullptr;
+      // Where the maps lie (MTL -s, -o, -clamp), as the renderer places every map.
+      m["uv_scale"] =
+          ojson::array({rounded(loaded->uv_scale.x, 6), rounded(loaded->uv_scale.y, 6)});
+      m["uv_offset"] =
+          ojson::array({rounded(loaded->uv_offset.x, 6), rounded(loaded->uv_offset.y, 6)});
+      m["clamp_maps"] = loaded->clamp_maps;
     }
     ojson maps = ojson::array();
     for (const Reference& r : s.maps) maps.push_back(reference_json(r));
@@ -256,6 +262,16 @@ void print_references(const ojson& info) {
   for (const ojson& m : info["materials"]) {
     std::string kd = m.contains("diffuse") ? "  Kd " + triple(m["diffuse"]) : "";
     std::printf("    %s%s\n", m["name"].get<std::string>().c_str(), kd.c_str());
+    if (m.contains("uv_scale") &&
+        (m["uv_scale"] != ojson::array({1, 1}) || m["uv_offset"] != ojson::array({0, 0}) ||
+         m["clamp_maps"].get<bool>())) {
+      auto pair = [](const ojson& v) {
+        return number(v[0].get<double>()) + " " + number(v[1].get<double>());
+      };
+      std::printf("      maps placed at uv * (%s) + (%s)%s\n", pair(m["uv_scale"]).c_str(),
+                  pair(m["uv_offset"]).c_str(),
+                  m["clamp_maps"].get<bool>() ? ", clamped to the edge" : "");
+    }
     for (const ojson& r : m["maps"]) {
       std::printf("      %s %s\n", r["kind"].get<std::string>().c_str(), found_text(r).c_str());
     }
@@ -279,8 +295,8 @@ void define_info_flags(CLI::App& app, InfoArgs& a) {
   app.footer(
       "Vertices are the mesh's (one per distinct position/normal/uv corner), triangles after "
       "fan triangulation. Files a model names are looked up as the loader does (MTL libraries "
-      "beside the OBJ, maps beside their MTL) and marked found or MISSING; only map_Kd is "
-      "drawn.\n\n"
+      "beside the OBJ, maps beside their MTL) and marked found or MISSING. A material whose "
+      "maps have -s, -o or -clamp options says where its maps are placed.\n\n"
       "Examples:\n"
       "  softrast info model.obj\n"
       "  softrast info assets/*.obj --json | jq .triangles");

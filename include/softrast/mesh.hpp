@@ -39,6 +39,13 @@ struct Material {
   NormalSpace normal_space = NormalSpace::kTangent;
   float normal_scale = 1.0f;                 // -bm: scales the map's x and y (its slope)
   std::shared_ptr<const Texture> alpha_map;  // map_d: its red channel multiplies the alpha
+  // Where the maps lie on the surface, from the maps' MTL options: -s u v (scale) and -o u v
+  // (origin offset) read every map at uv * uv_scale + uv_offset; -clamp on clamps them to the
+  // edge instead of repeating. One placement for all the maps of a material (the options of
+  // map_Kd, or of the first map that has any); a --texture given instead is placed the same way.
+  glm::vec2 uv_scale{1.0f};
+  glm::vec2 uv_offset{0.0f};
+  bool clamp_maps = false;
   // glTF's metallic-roughness material (set by the glTF loader, which also sets diffuse and
   // diffuse_map to the base colour for the other shaders); ShaderKind::kPbr draws a material
   // without one as a dielectric of its diffuse colour.

@@ -4,6 +4,7 @@
 
 #include "io/mtl_materials.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -52,6 +53,59 @@ bool mtl_number_out_of_range(std::string_view word) {
     ++digits;
   }
   return digits > 9;
+}
+
+// A map statement's line with the numbers of -o, -s and -t written out to three. MTL lets v and w
+// be left out ("map_Kd -s 2 2 tiles.png"), but tinyobj reads three numbers after each: it takes
+// the file's name for the missing w, and the map is lost. The missing ones are their defaults:
+// 1 for -s, 0 for -o and -t. Other lines, and everything from the file's name on, are as they
+// were (a name may hold spaces).
+std::string complete_map_options(std::string_view line) {
+  size_t at = 0;
+  auto next_word = [&]() -> std::string_view {
+    at = line.find_first_not_of(" \t", at);
+    if (at == std::string_view::npos) return at = line.size(), std::string_view{};
+    size_t end = std::min(line.find_first_of(" \t\r", at), line.size());
+    std::string_view word = line.substr(at, end - at);
+    at = end;
+    return word;
+  };
+  auto is_number = [](std::string_view w) {
+    float ignored = 0.0f;
+    return !w.empty() && parse_obj_float(w, ignored) == ObjNumber::kOk;
+  };
+  std::string_view statement = next_word();
+  static constexpr std::string_view kMaps[] = {
+      "map_Ka", "map_Kd", "map_Ks", "map_Ns", "map_d",  "map_Bump", "map_bump", "bump",
+      "norm",   "disp",   "decal",  "refl",   "map_Pr", "map_Pm",   "map_Ps",   "map_Ke"};
+  if (std::find(std::begin(kMaps), std::end(kMaps), statement) == std::end(kMaps)) {
+    return std::string(line);
+  }
+  std::string out(line.substr(0, at));
+  for (;;) {
+    size_t word_start = at;
+    std::string_view word = next_word();
+    if (word != "-o" && word != "-s" && word != "-t") {
+      // Another option's words pass as they are; the first word that is no option's starts
+      // the file's name (and the rest of the line goes with it).
+      out.append(line.substr(word_start));
+      return out;
+    }
+    out.append(line.substr(word_start, at - word_start));
+    int numbers = 0;
+    while (numbers < 3) {
+      size_t before = at;
+      std::string_view value = next_word();
+      if (!is_number(value)) {
+        at = before;
+        break;
+      }
+      out.append(line.substr(before, at - before));
+      ++numbers;
+    }
+    if (numbers == 0) continue;  // nothing to complete: tinyobj's own reading stands
+    for (; numbers < 3; ++numbers) out.append(word == "-s" ? " 1" : " 0");
+  }
 }
 
 // For each material that tinyobj::LoadMtl will produce from `text`, in its order, which of Kd,
@@ -117,7 +171,7 @@ Status ObjMaterials::load_library(const std::string& name, const std::string& ob
             return fail_at(path.string(), number, "number " + std::string(w) + " is out of range");
           }
         }
-        text.append(line);
+        text.append(complete_map_options(line));
         text += '\n';
         return Status();
       });
@@ -243,6 +297,20 @@ bool finite(const glm::vec3& v) {
   return std::isfinite(v.x + v.y + v.z);
 }
 
+// A map's placement options as Material keeps them (-s and -o in u and v; w is for 3D maps).
+struct Placement {
+  glm::vec2 scale{1.0f};
+  glm::vec2 offset{0.0f};
+  bool clamp = false;
+  bool operator==(const Placement&) const = default;
+};
+
+Placement placement_of(const tinyobj::texture_option_t& o) {
+  return {{float(o.scale[0]), float(o.scale[1])},
+          {float(o.origin_offset[0]), float(o.origin_offset[1])},
+          o.clamp};
+}
+
 }  // namespace
 
 Result<std::vector<Material>> ObjMaterials::convert(const std::string& path,
@@ -292,6 +360,46 @@ Result<std::vector<Material>> ObjMaterials::convert(const std::string& path,
                             norm ? "norm" : "map_Bump", warnings)) {
       m.normal_map = map->texture;
       m.normal_scale = map->from_height ? 1.0f : scale;
+    }
+    // The placement of the maps: map_Kd's options (the map most of the surface shows), else
+    // those of the first map that has any. MTL allows them per map; a material whose maps
+    // differ is drawn with that one's, and says so.
+    struct Named {
+      const char* statement;
+      const std::string& texname;
+      const tinyobj::texture_option_t& options;
+    };
+    const Named maps[] = {
+        {"map_Kd", source.diffuse_texname, source.diffuse_texopt},
+        {"map_Ks", source.specular_texname, source.specular_texopt},
+        {"map_d", source.alpha_texname, source.alpha_texopt},
+        {norm ? "norm" : "map_Bump", bump_name, norm ? source.normal_texopt : source.bump_texopt},
+    };
+    const Named* placed = nullptr;
+    for (const Named& map : maps) {
+      if (map.texname.empty()) continue;
+      if (placed == nullptr) placed = &map;
+      if (&map == &maps[0] || placement_of(map.options) != Placement{}) {
+        placed = &map;
+        break;
+      }
+    }
+    if (placed != nullptr) {
+      Placement p = placement_of(placed->options);
+      if (!std::isfinite(p.scale.x + p.scale.y + p.offset.x + p.offset.y)) {
+        return fail(
+            path, std::string(placed->statement) + " of " + named + ": its -s or -o is not finite");
+      }
+      m.uv_scale = p.scale;
+      m.uv_offset = p.offset;
+      m.clamp_maps = p.clamp;
+      for (const Named& map : maps) {
+        if (!map.texname.empty() && placement_of(map.options) != p) {
+          warnings.push_back(where + map.statement + ": its -s, -o or -clamp differ from " +
+                             placed->statement + "'s; every map of the material is placed as " +
+                             placed->statement + " is");
+        }
+      }
     }
     materials.push_back(std::move(m));
   }

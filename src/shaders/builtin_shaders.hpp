@@ -45,7 +45,12 @@ struct Lighting {
 struct MeshInputs {
   const Mesh* mesh = nullptr;
   glm::mat4 mvp{1.0f};
+  // The material's placement of its maps (Material::uv_scale, uv_offset): an affine map of the
+  // uvs, so applying it per vertex gives the interpolated uvs it would give per pixel.
+  glm::vec2 uv_scale{1.0f};
+  glm::vec2 uv_offset{0.0f};
   glm::vec4 clip(uint32_t i) const { return mvp * glm::vec4(mesh->positions[i], 1.0f); }
+  glm::vec2 uv(uint32_t i) const { return mesh->uvs[i] * uv_scale + uv_offset; }
 };
 
 // Samples at the uv in varyings (i, i + 1), with their derivatives when the filter needs them.
@@ -137,7 +142,8 @@ struct TextureShader {
   bool srgb = false;  // encode the output (the linear workflow)
   bool reads_derivatives() const { return sampler.filter == Filter::kTrilinear; }
   glm::vec4 vertex(uint32_t i, float* v) const {
-    v[0] = in.mesh->uvs[i].x, v[1] = in.mesh->uvs[i].y;
+    glm::vec2 uv = in.uv(i);
+    v[0] = uv.x, v[1] = uv.y;
     return in.clip(i);
   }
   template <int N>
@@ -200,7 +206,7 @@ struct PhongShader {
     const glm::vec3& n = in.mesh->normals[i];
     v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = n.x, v[4] = n.y, v[5] = n.z;
     if constexpr (kUv) {
-      const glm::vec2& uv = in.mesh->uvs[i];
+      glm::vec2 uv = in.uv(i);
       v[6] = uv.x, v[7] = uv.y;
     }
     if constexpr (kTangents) {

@@ -27,11 +27,25 @@ PbrMaterial fallback_material(const Mesh& mesh, int index, const RenderOptions& 
   p.metallic = 0.0f;
   p.roughness = 0.5f;
   p.double_sided = true;
+  // The filter and wrap asked for (--filter, --wrap), as the other shaders use them; a glTF
+  // material (below) has its file's samplers.
+  p.base_color_map.sampler.filter = opt.sampler.filter;
+  p.base_color_map.sampler.wrap_u = opt.sampler.wrap_u;
+  p.base_color_map.sampler.wrap_v = opt.sampler.wrap_v;
   if (index >= 0 && size_t(index) < mesh.materials.size()) {
     const Material& m = mesh.materials[size_t(index)];
     if (m.pbr) return *m.pbr;
     p.base_color = glm::vec4(m.diffuse, 1.0f);
     p.base_color_map.texture = m.diffuse_map;
+    // The material's placement of its maps (MTL -s, -o, -clamp) as a texture transform.
+    if (m.uv_scale != glm::vec2(1.0f) || m.uv_offset != glm::vec2(0.0f)) {
+      p.base_color_map.u_row = {m.uv_scale.x, 0.0f, m.uv_offset.x};
+      p.base_color_map.v_row = {0.0f, m.uv_scale.y, m.uv_offset.y};
+      p.base_color_map.transformed = true;
+    }
+    if (m.clamp_maps) {
+      p.base_color_map.sampler.wrap_u = p.base_color_map.sampler.wrap_v = Wrap::kClampToEdge;
+    }
   }
   return p;
 }

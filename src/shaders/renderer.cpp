@@ -30,6 +30,10 @@ struct Surface {
   glm::vec3 albedo;
   const Texture* texture;      // null: untextured
   detail::SurfaceMaps maps{};  // phong's material (maps.diffuse is `texture`)
+  // The material's placement of its maps (Material::uv_scale, uv_offset, clamp_maps).
+  glm::vec2 uv_scale{1.0f};
+  glm::vec2 uv_offset{0.0f};
+  bool clamp_maps = false;
 };
 
 using Maps = RenderOptions::Maps;
@@ -44,6 +48,9 @@ Surface surface_of(const Mesh& mesh, int material, const RenderOptions& opt) {
     s.maps.specular_color = m.specular * opt.light_intensity;
     s.maps.shininess = m.shininess;
     s.maps.opacity = m.opacity;
+    s.uv_scale = m.uv_scale;
+    s.uv_offset = m.uv_offset;
+    s.clamp_maps = m.clamp_maps;
     if (opt.maps == Maps::kAll) {
       s.maps.specular = m.specular_map.get();
       s.maps.normal = m.normal_map.get();
@@ -96,7 +103,7 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
               const RenderOptions& opt, ShaderKind kind, DepthRange depth,
               const detail::ShadowMap* shadow = nullptr) {
   using namespace detail;
-  MeshInputs in{&mesh, mvp};
+  MeshInputs in{&mesh, mvp, surf.uv_scale, surf.uv_offset};
   uint32_t n = uint32_t(mesh.positions.size());
   Lighting lighting = lighting_of(opt);
   lighting.shadow = shadow;
@@ -105,6 +112,7 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
   static const Texture kWhite;  // samples as opaque white
   Sampler sampler = opt.sampler;
   sampler.srgb_decode = opt.srgb;
+  if (surf.clamp_maps) sampler.wrap_u = sampler.wrap_v = Wrap::kClampToEdge;
   // Vertex colours (OBJ, PLY) are the albedo of flat, gouraud and phong where no diffuse map is.
   ColorSource colors{mesh.colors.size() == mesh.positions.size() && !surf.maps.diffuse, opt.srgb};
   switch (kind) {
