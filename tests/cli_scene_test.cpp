@@ -360,6 +360,91 @@ TEST(CliFraming, HugeAndTinyUnitsAreFramedLikeUnitOnes) {
   }
 }
 
+// A UV sphere (24 x 16, normals and uvs) of radius `scale` at (scale, 0, 0), as OBJ text.
+std::string sphere_obj(float scale) {
+  std::ostringstream obj;
+  obj.precision(9);
+  const int kSlices = 24, kStacks = 16;
+  for (int j = 0; j <= kStacks; ++j) {
+    float theta = float(M_PI) * float(j) / kStacks;
+    for (int i = 0; i <= kSlices; ++i) {
+      float phi = 2.0f * float(M_PI) * float(i) / kSlices;
+      float x = std::sin(theta) * std::cos(phi), y = std::cos(theta),
+            z = std::sin(theta) * std::sin(phi);
+      obj << "v " << (x + 1.0f) * scale << " " << y * scale << " " << z * scale << "\n";
+      obj << "vn " << x << " " << y << " " << z << "\n";
+      obj << "vt " << float(i) / kSlices * 2.0f << " " << float(j) / kStacks << "\n";
+    }
+  }
+  auto at = [&](int i, int j) { return std::to_string(j * (kSlices + 1) + i + 1); };
+  for (int j = 0; j < kStacks; ++j) {
+    for (int i = 0; i < kSlices; ++i) {
+      std::string a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+      obj << "f " << a << "/" << a << "/" << a << " " << d << "/" << d << "/" << d << " " << c
+          << "/" << c << "/" << c << " " << b << "/" << b << "/" << b << "\n";
+    }
+  }
+  return obj.str();
+}
+
+// A model in units of 1e30, 1e9, 1e-9 or 1e-30 is shaded as the same model in units of 1: every
+// lit shader, a point light (placed in the same units), shadows and a texture, colours within
+// 2/255 where both images cover the pixel. Two things broke this: 1/w of vertices 1e30 away fell
+// under the fragment stage's floor of 1e-30, so interpolated values came out 0.37 times too small
+// (gouraud's colours, phong's positions, pbr's vertex colour), and phong's eye - p and pbr's view
+// rays overflowed float when squared, which lost the highlight.
+TEST(CliFraming, HugeAndTinyUnitsAreShadedLikeUnitOnes) {
+  CliFolder folder;
+  Image checker(8, 8);
+  for (int y = 0; y < 8; ++y) {
+    for (int x = 0; x < 8; ++x) {
+      uint8_t* p = checker.pixel(x, y);
+      bool light = (x + y) % 2 == 0;
+      p[0] = light ? 230 : uint8_t(30 * x), p[1] = light ? 230 : uint8_t(30 * y), p[2] = 90;
+      p[3] = 255;
+    }
+  }
+  ASSERT_TRUE(save_image(folder.path("tex.png"), checker).ok());
+  folder.write("unit.obj", sphere_obj(1.0f));
+  const std::string kCommon = " --background 0,0,0 --size 96x72 --view iso ";
+  for (float scale : {1e30f, 1e9f, 1e-9f, 1e-30f}) {
+    folder.write("scaled.obj", sphere_obj(scale));
+    std::ostringstream light;
+    light.precision(9);
+    light << "--shader phong --light-pos " << 3 * scale << "," << 4 * scale << "," << 5 * scale;
+    const std::pair<std::string, std::string> kShaders[] = {
+        {"--shader gouraud", "--shader gouraud"},
+        {"--shader phong", "--shader phong"},
+        {"--shader phong --light-pos 3,4,5", light.str()},
+        {"--shader phong --shadows", "--shader phong --shadows"},
+        {"--shader pbr", "--shader pbr"},
+        {"--shader texture --texture tex.png", "--shader texture --texture tex.png"},
+        {"--shader phong --texture tex.png", "--shader phong --texture tex.png"}};
+    for (const auto& [unit_flags, scaled_flags] : kShaders) {
+      std::ostringstream what;
+      what << "scale " << scale << " " << scaled_flags;
+      Image a = folder.render("unit.obj" + kCommon + unit_flags, "unit.png");
+      Image b = folder.render("scaled.obj" + kCommon + scaled_flags, "scaled.png");
+      ASSERT_EQ(a.rgba.size(), b.rgba.size()) << what.str();
+      int coverage_differs = 0, compared = 0, worst = 0;
+      for (int y = 0; y < a.height; ++y) {
+        for (int x = 0; x < a.width; ++x) {
+          bool in_a = !is_background(a, x, y, {0, 0, 0}), in_b = !is_background(b, x, y, {0, 0, 0});
+          coverage_differs += in_a != in_b;
+          if (!in_a || !in_b) continue;
+          ++compared;
+          for (int c = 0; c < 3; ++c) {
+            worst = std::max(worst, std::abs(int(a.pixel(x, y)[c]) - int(b.pixel(x, y)[c])));
+          }
+        }
+      }
+      EXPECT_GT(compared, 1000) << what.str();
+      EXPECT_LE(coverage_differs, 8) << what.str();
+      EXPECT_LE(worst, 2) << what.str();
+    }
+  }
+}
+
 // A view preset is its azimuth and elevation.
 TEST(CliFraming, ViewPresetsAreAngles) {
   CliFolder folder;

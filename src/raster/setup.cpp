@@ -57,12 +57,14 @@ Plane to_float(const DepthPlane& p) {
   return {float(p.a0), float(p.dadx), float(p.dady)};
 }
 
-// The 1/w of a primitive's vertices for its planes: as they are, unless the largest exceeds 2^20
-// (w under about 1e-6: a scene in tiny units); then all times the power of two that brings the
-// largest to [0.5, 1). Scaling by a power of two is exact, so the fragment stage's quotient
-// plane(var) / plane(1/w) is unchanged bit for bit, but var / w stays far from float's range (1/w
-// reaches 1e30 at the clipper's smallest w).
-[[gnu::cold, gnu::noinline]] void scale_tiny_w(double* inv_w, int count) {
+// The 1/w of a primitive's vertices for its planes: as they are, unless the largest is outside
+// [2^-20, 2^20] (w under about 1e-6 or over about 1e6: a scene in tiny or huge units); then all
+// times the power of two that brings the largest to [0.5, 1). Scaling by a power of two is exact,
+// so the fragment stage's quotient plane(var) / plane(1/w) is unchanged bit for bit, but var / w
+// stays far from float's limits: 1/w reaches 1e30 at the clipper's smallest w, and falls below
+// the fragment stage's floor of 1e-30 where w is larger (a model in units of 1e30, whose
+// interpolated colours came out 0.37 times too dark), or into float's denormals.
+[[gnu::cold, gnu::noinline]] void scale_inv_w(double* inv_w, int count) {
   double largest = *std::max_element(inv_w, inv_w + count);
   int exponent = 0;
   std::frexp(largest, &exponent);
@@ -70,10 +72,10 @@ Plane to_float(const DepthPlane& p) {
 }
 template <int kCount>
 void scaled_inv_w(const float (&in)[kCount], double (&out)[kCount]) {
-  bool tiny = false;
-  for (int k = 0; k < kCount; ++k) out[k] = in[k], tiny |= in[k] > 0x1p20f;
-  if (tiny) [[unlikely]] {
-    scale_tiny_w(out, kCount);
+  float largest = in[0];
+  for (int k = 0; k < kCount; ++k) out[k] = in[k], largest = std::max(largest, in[k]);
+  if (!(largest <= 0x1p20f && largest >= 0x1p-20f)) [[unlikely]] {
+    if (largest > 0.0f && std::isfinite(largest)) scale_inv_w(out, kCount);
   }
 }
 
@@ -132,7 +134,7 @@ void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area
   out.x_ref = float(to_pixels(v[0]->x));
   out.y_ref = float(to_pixels(v[0]->y));
   out.z = plane(v[0]->z, v[1]->z, v[2]->z);
-  double iw[3];  // 1/w, times a power of two where w is tiny (scaled_inv_w)
+  double iw[3];  // 1/w, times a power of two where w is tiny or huge (scaled_inv_w)
   scaled_inv_w({v[0]->inv_w, v[1]->inv_w, v[2]->inv_w}, iw);
   const double w0 = iw[0], w1 = iw[1], w2 = iw[2];
   out.inv_w = to_float(plane(w0, w1, w2));

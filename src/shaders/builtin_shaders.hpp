@@ -49,8 +49,12 @@ struct MeshInputs {
   // uvs, so applying it per vertex gives the interpolated uvs it would give per pixel.
   glm::vec2 uv_scale{1.0f};
   glm::vec2 uv_offset{0.0f};
+  // The world positions a shader interpolates, times this power of two (shading_scale in
+  // renderer.cpp): 1 unless the scene is in units far from 1.
+  float position_scale = 1.0f;
   glm::vec4 clip(uint32_t i) const { return mvp * glm::vec4(mesh->positions[i], 1.0f); }
   glm::vec2 uv(uint32_t i) const { return mesh->uvs[i] * uv_scale + uv_offset; }
+  glm::vec3 position(uint32_t i) const { return mesh->positions[i] * position_scale; }
 };
 
 // Samples at the uv in varyings (i, i + 1), with their derivatives when the filter needs them.
@@ -183,7 +187,9 @@ enum class PhongInputs { kPlain, kUv, kTangentFrame, kColors };
 // the tangent frame interpolated: 4 more varyings), one directional or point light.
 // Without maps and with SCENES.md's values it computes exactly what it always has. kPlain
 // leaves out the texture coordinates that no map reads: two planes less to set up per triangle
-// and to interpolate per block, the same image.
+// and to interpolate per block, the same image. World positions arrive times in.position_scale,
+// and `eye` and `lighting.position` are given so scaled: the directions are the same, and eye - p
+// and its squared length stay inside float's range in scenes of units of 1e30 or 1e-30.
 template <PhongInputs kInputs>
 struct PhongShader {
   static constexpr bool kUv = kInputs == PhongInputs::kUv || kInputs == PhongInputs::kTangentFrame;
@@ -202,7 +208,7 @@ struct PhongShader {
   // Only the maps' trilinear lookups read derivatives (shadows and lighting do not).
   bool reads_derivatives() const { return kUv && sampler.filter == Filter::kTrilinear; }
   glm::vec4 vertex(uint32_t i, float* v) const {
-    const glm::vec3& p = in.mesh->positions[i];
+    const glm::vec3 p = in.position(i);
     const glm::vec3& n = in.mesh->normals[i];
     v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = n.x, v[4] = n.y, v[5] = n.z;
     if constexpr (kUv) {
@@ -261,8 +267,11 @@ struct PhongShader {
       a = base.w * a;
       if (maps.alpha) a = a * sample_with_derivatives(*maps.alpha, sampler, f, 6).x;
     }
-    F visible =
-        lighting.shadow ? shadow_visibility<N>(*lighting.shadow, p, simd::dot(n, l)) : F(1.0f);
+    // The shadow map is in world units: p without the position scale (exact: a power of two).
+    F visible = lighting.shadow
+                    ? shadow_visibility<N>(*lighting.shadow, p * F(1.0f / in.position_scale),
+                                           simd::dot(n, l))
+                    : F(1.0f);
     F lit = simd::fma(F(lighting.diffuse) * light.diffuse, visible, F(lighting.ambient));
     F spec = light.specular * visible;
     f.color = {simd::fma(base.x, lit, ks.x * spec), simd::fma(base.y, lit, ks.y * spec),

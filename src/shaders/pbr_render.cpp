@@ -58,6 +58,21 @@ struct BlendTriangle {
 
 }  // namespace
 
+float shading_scale(const Camera& camera, const RenderOptions& opt) {
+  float largest = std::max({std::abs(camera.eye.x), std::abs(camera.eye.y), std::abs(camera.eye.z),
+                            std::abs(camera.far_plane)});
+  if (opt.light_position) {
+    const glm::vec3& l = *opt.light_position;
+    largest = std::max({largest, std::abs(l.x), std::abs(l.y), std::abs(l.z)});
+  }
+  float nearest = std::abs(camera.near_plane);
+  if (!std::isfinite(largest) || largest == 0.0f) return 1.0f;
+  if (largest <= 0x1p32f && nearest >= 0x1p-32f) return 1.0f;
+  int exponent = 0;
+  std::frexp(largest, &exponent);
+  return std::ldexp(1.0f, -exponent);
+}
+
 void render_pbr(Framebuffer& fb, const Mesh& mesh, const Camera& camera, const glm::mat4& mvp,
                 std::span<const SubMesh> runs, const RenderState& state, const RenderOptions& opt) {
   std::vector<PbrMaterial> materials;
@@ -73,6 +88,12 @@ void render_pbr(Framebuffer& fb, const Mesh& mesh, const Camera& camera, const g
   light.key = kKey * opt.light_intensity;
   light.exposure_scale = std::exp2(opt.exposure);
   glm::mat4 inverse_mvp = glm::inverse(mvp);
+  // View rays in units scaled by shading_scale (rows x, y, z of the unprojection; w is the
+  // divisor): the same directions.
+  const float scale = shading_scale(camera, opt);
+  for (int column = 0; column < 4; ++column) {
+    for (int row = 0; row < 3; ++row) inverse_mvp[column][row] *= scale;
+  }
   uint32_t vertex_count = uint32_t(mesh.positions.size());
 
   auto draw_indices = [&](size_t r, std::span<const uint32_t> indices, bool blended) {

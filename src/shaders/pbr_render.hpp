@@ -18,4 +18,12 @@ void render_pbr(Framebuffer& framebuffer, const Mesh& mesh, const Camera& camera
                 const glm::mat4& mvp, std::span<const SubMesh> runs, const RenderState& state,
                 const RenderOptions& options);
 
+// The power of two that the lit shaders' world positions, eye and point light (phong) or view
+// rays (pbr) are scaled by: 1 while the scene's distances stay within 2^-32 .. 2^32 (the image
+// is then what it always was); otherwise the one that brings the largest of them (the eye, the
+// far plane, a point light) to [0.5, 1). Lighting reads only directions, which the scale leaves
+// alone, but a squared length overflows float beyond about 2^64 (units of 1e30: the highlight
+// was lost) and underflows below 2^-63.
+float shading_scale(const Camera& camera, const RenderOptions& options);
+
 }  // namespace softrast::detail

@@ -141,29 +141,32 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
     case ShaderKind::kPhong:
     case ShaderKind::kPbr: {  // pbr is drawn by render_pbr; phong if it ever gets here
       SurfaceMaps maps = surf.maps;
+      in.position_scale = detail::shading_scale(camera, opt);
+      const glm::vec3 eye = camera.eye * in.position_scale;
+      lighting.position *= in.position_scale;
       bool tangents = maps.normal && !maps.object_space;
       if (tangents && mesh.tangents.size() == mesh.positions.size()) {
         return draw(fb, state,
                     PhongShader<PhongInputs::kTangentFrame>{
-                        in, surf.albedo, maps, sampler, lighting, camera.eye, opt.alpha, {}},
+                        in, surf.albedo, maps, sampler, lighting, eye, opt.alpha, {}},
                     indices, n);
       }
       if (tangents) maps.normal = nullptr;  // no tangent frame: the interpolated normal
       if (maps.diffuse || maps.specular || maps.normal || maps.alpha) {
         return draw(fb, state,
                     PhongShader<PhongInputs::kUv>{
-                        in, surf.albedo, maps, sampler, lighting, camera.eye, opt.alpha, {}},
+                        in, surf.albedo, maps, sampler, lighting, eye, opt.alpha, {}},
                     indices, n);
       }
       if (colors.use) {
         return draw(fb, state,
-                    PhongShader<PhongInputs::kColors>{in, surf.albedo, maps, sampler, lighting,
-                                                      camera.eye, opt.alpha, colors},
+                    PhongShader<PhongInputs::kColors>{in, surf.albedo, maps, sampler, lighting, eye,
+                                                      opt.alpha, colors},
                     indices, n);
       }
       return draw(fb, state,
                   PhongShader<PhongInputs::kPlain>{
-                      in, surf.albedo, maps, sampler, lighting, camera.eye, opt.alpha, {}},
+                      in, surf.albedo, maps, sampler, lighting, eye, opt.alpha, {}},
                   indices, n);
     }
     case ShaderKind::kNormals:

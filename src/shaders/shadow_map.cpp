@@ -1,6 +1,7 @@
 // shaders/shadow_map.cpp: the depth pass from the light.
 #include "shaders/shadow_map.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -41,6 +42,21 @@ ShadowMap build_shadow_map(const Mesh& mesh, glm::vec3 towards_light, int size, 
     map.light_vp = glm::mat4(0.0f);  // every point maps to the centre at depth 0.5: lit
     return map;
   }
+  // The map is fitted in units where the box's largest coordinate is in [0.5, 1) when it lies
+  // outside 2^-20 .. 2^20 (a model in units of 1e30 or 1e-30: the box's diagonal squared
+  // overflowed float, or the floors below were larger than the model). The units are a power of
+  // two times the world's, so the fit is exact, and light_vp takes world positions: the scale is
+  // its first step.
+  float largest = std::max({std::abs(box.lo.x), std::abs(box.lo.y), std::abs(box.lo.z),
+                            std::abs(box.hi.x), std::abs(box.hi.y), std::abs(box.hi.z)});
+  float unit = 1.0f;
+  if (std::isfinite(largest) && largest > 0.0f && (largest > 0x1p20f || largest < 0x1p-20f)) {
+    int exponent = 0;
+    std::frexp(largest, &exponent);
+    unit = std::ldexp(1.0f, -exponent);
+    box.lo *= unit;
+    box.hi *= unit;
+  }
   // A view from the light towards the box's centre, then the orthographic box that holds the
   // eight corners exactly (with a small margin in depth, so the nearest and farthest surfaces
   // are not clipped).
@@ -61,6 +77,7 @@ ShadowMap build_shadow_map(const Mesh& mesh, glm::vec3 towards_light, int size, 
   float w = std::max(hi.x - lo.x, 1.0e-6f), h = std::max(hi.y - lo.y, 1.0e-6f);
   glm::mat4 proj = glm::orthoRH_NO(lo.x, lo.x + w, lo.y, lo.y + h, near_plane, far_plane);
   map.light_vp = proj * view;
+  if (unit != 1.0f) map.light_vp = map.light_vp * glm::scale(glm::mat4(1.0f), glm::vec3(unit));
   map.texel_depth = std::max(w, h) / float(size) / (far_plane - near_plane);
 
   Framebuffer fb(size, size);
