@@ -392,7 +392,8 @@ std::string sphere_obj(float scale) {
 // 2/255 where both images cover the pixel. Two things broke this: 1/w of vertices 1e30 away fell
 // under the fragment stage's floor of 1e-30, so interpolated values came out 0.37 times too small
 // (gouraud's colours, phong's positions, pbr's vertex colour), and phong's eye - p and pbr's view
-// rays overflowed float when squared, which lost the highlight.
+// rays overflowed float when squared, which lost the highlight; the depth view's range (near times
+// far) overflowed too, and the image was black.
 TEST(CliFraming, HugeAndTinyUnitsAreShadedLikeUnitOnes) {
   CliFolder folder;
   Image checker(8, 8);
@@ -419,7 +420,9 @@ TEST(CliFraming, HugeAndTinyUnitsAreShadedLikeUnitOnes) {
         {"--shader phong --shadows", "--shader phong --shadows"},
         {"--shader pbr", "--shader pbr"},
         {"--shader texture --texture tex.png", "--shader texture --texture tex.png"},
-        {"--shader phong --texture tex.png", "--shader phong --texture tex.png"}};
+        {"--shader phong --texture tex.png", "--shader phong --texture tex.png"},
+        {"--shader depth", "--shader depth"},
+        {"--shader normals", "--shader normals"}};
     for (const auto& [unit_flags, scaled_flags] : kShaders) {
       std::ostringstream what;
       what << "scale " << scale << " " << scaled_flags;

@@ -177,12 +177,13 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
   }
 }
 
-// The view depth (distance along the view direction) of window depth `z` in [0, 1].
+// The view depth (distance along the view direction) of window depth `z` in [0, 1]. In double:
+// n * f overflows float for a model in units of 1e30 (and underflows it at 1e-30).
 float view_depth(const Camera& camera, float z) {
-  float n = camera.near_plane, f = camera.far_plane;
-  if (camera.orthographic) return n + z * (f - n);
-  float z_ndc = 2.0f * z - 1.0f;
-  return 2.0f * n * f / ((f + n) - z_ndc * (f - n));
+  double n = camera.near_plane, f = camera.far_plane;
+  if (camera.orthographic) return float(n + z * (f - n));
+  double z_ndc = 2.0 * z - 1.0;
+  return float(2.0 * n * f / ((f + n) - z_ndc * (f - n)));
 }
 
 // The nearest and farthest view depth among the pixels `runs` cover with the depth test on: a
