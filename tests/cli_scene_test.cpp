@@ -388,12 +388,12 @@ std::string sphere_obj(float scale) {
 }
 
 // A model in units of 1e30, 1e9, 1e-9 or 1e-30 is shaded as the same model in units of 1: every
-// lit shader, a point light (placed in the same units), shadows and a texture, colours within
-// 2/255 where both images cover the pixel. Two things broke this: 1/w of vertices 1e30 away fell
-// under the fragment stage's floor of 1e-30, so interpolated values came out 0.37 times too small
-// (gouraud's colours, phong's positions, pbr's vertex colour), and phong's eye - p and pbr's view
-// rays overflowed float when squared, which lost the highlight; the depth view's range (near times
-// far) overflowed too, and the image was black.
+// lit shader, a point light (placed in the same units), shadows, a texture, the depth and normals
+// views, colours within 2/255 where both images cover the pixel. Three things broke this: 1/w of
+// vertices 1e30 away fell under the fragment stage's floor of 1e-30, so interpolated values came
+// out 0.37 times too small (gouraud's colours, phong's positions, pbr's vertex colour); phong's
+// eye - p and pbr's view rays overflowed float when squared, which lost the highlight; and the
+// depth view's range (near times far) overflowed too, and the image was black.
 TEST(CliFraming, HugeAndTinyUnitsAreShadedLikeUnitOnes) {
   CliFolder folder;
   Image checker(8, 8);
