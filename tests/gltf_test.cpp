@@ -344,6 +344,12 @@ std::vector<BadCase> bad_cases() {
          return test::as_gltf(g);
        },
        "mesh 0 primitive 0: index 99 is past the vertex count 24 (accessor 3)"},
+      {"OnlyLines", "lines.gltf",
+       [](GltfParts g, const std::string&) {
+         g.json["meshes"][0]["primitives"][0]["mode"] = 1;  // LINES
+         return test::as_gltf(g);
+       },
+       "no triangles to draw: its 1 primitive is points or lines, which softrast does not draw"},
       {"CountOf2To31", "huge.gltf",
        [](GltfParts g, const std::string&) {
          g.json["accessors"][0]["count"] = 2147483648u;

@@ -574,6 +574,7 @@ void add_tangents(Piece& piece) {
 struct Builder {
   Mesh mesh;
   bool any_tangents = false, any_uvs1 = false, any_colors = false;
+  int skipped_points_and_lines = 0;  // primitives not drawn (their warning names each)
   std::vector<glm::vec4> tangents, colors;
   std::vector<glm::vec2> uvs1;
 };
@@ -705,6 +706,7 @@ struct Flattener {
       if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES &&
           p.mode != TINYGLTF_MODE_TRIANGLE_STRIP && p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
         builder.mesh.warnings.push_back(pwhat + ": points and lines are not drawn");
+        ++builder.skipped_points_and_lines;
         continue;
       }
       if (empty.count({index, k})) continue;
@@ -793,7 +795,14 @@ Result<Mesh> gltf_to_mesh(GltfDocument& doc, const std::string& name, const std:
     }
   }
   if (!status.ok()) return fail(name, status.message());
-  if (b.mesh.indices.empty()) return fail(name, "no triangles to draw");
+  if (b.mesh.indices.empty()) {
+    if (b.skipped_points_and_lines > 0) {
+      return fail(name, "no triangles to draw: its " + std::to_string(b.skipped_points_and_lines) +
+                            " primitive" + (b.skipped_points_and_lines == 1 ? " is" : "s are") +
+                            " points or lines, which softrast does not draw");
+    }
+    return fail(name, "no triangles to draw");
+  }
   if (b.any_tangents) {
     b.tangents.resize(b.mesh.positions.size(), glm::vec4(1, 0, 0, 1));
     b.mesh.tangents = std::move(b.tangents);
