@@ -198,9 +198,17 @@ class BinnedDraw {
     t.bounds = {lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l], lanes.bounds[3][l]};
     rec->small = (lanes.small >> l) & 1u;
     const WindowVertex* ordered[3] = {&v[0], &v[1], &v[2]};
-    setup_triangle_interpolants(ordered, geometry_.num_varyings(), lanes.area[l], state_.front_face,
+    finish_record(chunk, offset, ordered, lanes.area[l]);
+  }
+
+  // Both paths end here: the record's interpolants (from the clockwise-ordered vertices) and its
+  // place in the bins, once its coverage is written.
+  void finish_record(Chunk& chunk, uint32_t offset, const WindowVertex* const ordered[3],
+                     int64_t area) {
+    TriRecord* rec = chunk.records.at(offset);
+    setup_triangle_interpolants(ordered, geometry_.num_varyings(), area, state_.front_face,
                                 rec->interp());
-    bin(chunk, t.bounds, offset);
+    bin(chunk, rec->coverage.bounds, offset);
   }
 
   // Whether a triangle of snapped signed area `area` survives culling (zero area never does).
@@ -228,9 +236,7 @@ class BinnedDraw {
       return int64_t(std::max({v[0], v[1], v[2]})) - std::min({v[0], v[1], v[2]});
     };
     rec->small = extent(t.vx) <= kSmallTriangleFx8 && extent(t.vy) <= kSmallTriangleFx8;
-    setup_triangle_interpolants(ordered, geometry_.num_varyings(), area, state_.front_face,
-                                rec->interp());
-    bin(chunk, t.bounds, offset);
+    finish_record(chunk, offset, ordered, area);
   }
 
   void bin(Chunk& chunk, const PixelRect& bounds, uint32_t offset) {
