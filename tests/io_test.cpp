@@ -548,7 +548,9 @@ TEST_F(IoTest, ObjErrors) {
   };
   const Case cases[] = {
       {"empty.obj", "", "no faces"},
-      {"points.obj", "v 0 0 0\nv 1 0 0\n", "no faces"},
+      {"points.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n",
+       "no faces: 2 vertices but no face (f) to draw; softrast draws faces, not points (p) or "
+       "lines (l)"},
       {"big.obj", std::string(kQuadPositions) + "f 1 2 5\n", "out of range"},
       {"neg.obj", std::string(kQuadPositions) + "f 1 2 -5\n", "out of range"},
       {"uv.obj", std::string(kQuadPositions) + "vt 0 0\nf 1/1 2/2 3/1\n", "out of range"},

@@ -305,6 +305,14 @@ TEST_F(ModelFormatsTest, MessagesNameTheFileAndPlace) {
   mesh = load_model(p);
   ASSERT_FALSE(mesh.ok());
   EXPECT_EQ(mesh.status().message(), p + ":4: unknown type 'flaot'");
+  // A point cloud (a scanner's PLY): what it is, not only what it lacks.
+  p = write("cloud.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n");
+  mesh = load_model(p);
+  ASSERT_FALSE(mesh.ok());
+  EXPECT_EQ(mesh.status().message(),
+            p + ": no faces: a point cloud of 3 vertices; softrast draws faces, not points");
   std::string stl = stl_binary();
   p = write("d.stl", stl.substr(0, stl.size() - 10));
   mesh = load_model(p);

@@ -426,7 +426,13 @@ Mesh ObjMerge::build_mesh() {
 }
 
 Result<Mesh> ObjMerge::finish() {
-  if (index_count_ == 0) return fail(path_, "no faces");
+  if (index_count_ == 0) {
+    size_t vertices = values_[0].count();
+    if (vertices == 0) return fail(path_, "no faces");
+    // Points and lines (p, l) are not drawn: say so, rather than only what is missing.
+    return fail(path_, "no faces: " + std::to_string(vertices) + " vertices but no face (f) to " +
+                           "draw; softrast draws faces, not points (p) or lines (l)");
+  }
   // Positive indices may name elements defined further down: checked against the final counts.
   for (int a = 0; a < 3; ++a) {
     if (largest_[a].value > int64_t(values_[a].count())) {

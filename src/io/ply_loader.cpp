@@ -658,7 +658,11 @@ Result<Mesh> PlyBuilder::build() {
     if (Status s = read_element(e); !s.ok()) return s;
   }
   if (!body_.at_clean_end()) return body_.error("end");
-  if (mesh_.indices.empty()) return fail(name_, "no faces");
+  if (mesh_.indices.empty()) {
+    if (vertex_count_ == 0) return fail(name_, "no faces");
+    return fail(name_, "no faces: a point cloud of " + std::to_string(vertex_count_) +
+                           " vertices; softrast draws faces, not points");
+  }
   for (glm::vec3& n : mesh_.normals) {
     float length = glm::length(n);
     n = length > 0.0f && std::isfinite(length) ? n / length : glm::vec3(0.0f, 0.0f, 1.0f);
