@@ -430,8 +430,10 @@ Result<Mesh> ObjMerge::finish() {
     size_t vertices = values_[0].count();
     if (vertices == 0) return fail(path_, "no faces");
     // Points and lines (p, l) are not drawn: say so, rather than only what is missing.
-    return fail(path_, "no faces: " + std::to_string(vertices) + " vertices but no face (f) to " +
-                           "draw; softrast draws faces, not points (p) or lines (l)");
+    return fail(path_, "no faces: " + std::to_string(vertices) +
+                           (vertices == 1 ? " vertex" : " vertices") +
+                           " but no face (f) to draw; softrast draws faces, not points (p) or "
+                           "lines (l)");
   }
   // Positive indices may name elements defined further down: checked against the final counts.
   for (int a = 0; a < 3; ++a) {

@@ -661,7 +661,8 @@ Result<Mesh> PlyBuilder::build() {
   if (mesh_.indices.empty()) {
     if (vertex_count_ == 0) return fail(name_, "no faces");
     return fail(name_, "no faces: a point cloud of " + std::to_string(vertex_count_) +
-                           " vertices; softrast draws faces, not points");
+                           (vertex_count_ == 1 ? " vertex" : " vertices") +
+                           "; softrast draws faces, not points");
   }
   for (glm::vec3& n : mesh_.normals) {
     float length = glm::length(n);
