@@ -49,8 +49,8 @@ struct MeshInputs {
   // uvs, so applying it per vertex gives the interpolated uvs it would give per pixel.
   glm::vec2 uv_scale{1.0f};
   glm::vec2 uv_offset{0.0f};
-  // The world positions a shader interpolates, times this power of two (shading_scale in
-  // renderer.cpp): 1 unless the scene is in units far from 1.
+  // The world positions a shader interpolates, times this power of two (shading_scale,
+  // pbr_render.hpp): 1 unless the scene is in units far from 1.
   float position_scale = 1.0f;
   glm::vec4 clip(uint32_t i) const { return mvp * glm::vec4(mesh->positions[i], 1.0f); }
   glm::vec2 uv(uint32_t i) const { return mesh->uvs[i] * uv_scale + uv_offset; }
