@@ -616,6 +616,37 @@ TEST_F(ScriptTest, InfoResolvesMapsAsTheRenderDoes) {
       << text.out;
 }
 
+// info on a PLY and a glTF file: no OBJ statement counts (they would all be 0) and no MTL
+// libraries; the glTF's material as loaded, unnamed ones said so.
+TEST_F(ScriptTest, InfoOnPlyAndGltfListsWhatTheyHold) {
+  write(work() / "tri.ply",
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  fs::copy_file(fs::path(SOFTRAST_FUZZ_DIR) / "corpus" / "gltf" / "cube.glb", work() / "cube.glb");
+  Outcome r = run("info tri.ply cube.glb --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::vector<std::string> lines = lines_of(r.out);
+  ASSERT_EQ(lines.size(), 2u) << r.out;
+  json ply = json::parse(lines[0]), glb = json::parse(lines[1]);
+  EXPECT_EQ(ply["triangles"], 1);
+  EXPECT_FALSE(ply.contains("file"));
+  EXPECT_FALSE(ply.contains("libraries"));
+  EXPECT_EQ(ply["materials"].size(), 0u);
+  EXPECT_EQ(glb["triangles"], 12);
+  EXPECT_FALSE(glb.contains("file"));
+  ASSERT_EQ(glb["materials"].size(), 1u);
+  EXPECT_EQ(glb["materials"][0]["pbr"], true);
+  EXPECT_EQ(glb["materials"][0]["diffuse_map_loaded"], true);
+  Outcome text = run("info cube.glb");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_EQ(text.out.find("(the file:"), std::string::npos) << text.out;
+  for (const char* part : {"  vertices   24\n", "    (unnamed material): 12 triangles\n",
+                           "  materials  1\n", "    (unnamed)  Kd 1 1 1  (metallic-roughness)"}) {
+    EXPECT_NE(text.out.find(part), std::string::npos) << "no '" << part << "' in\n" << text.out;
+  }
+}
+
 TEST_F(ScriptTest, InfoOnABrokenModelSaysWhyAndStillListsItsFiles) {
   write(work() / "broken.mtl", "newmtl skin\nmap_Kd skin.png\n");
   write(work() / "broken.obj",

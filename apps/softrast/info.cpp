@@ -211,6 +211,21 @@ ojson describe(const std::string& path) {
   if (!fs::is_regular_file(path, ec)) return info;
   Scan scan = scan_model(path);
   if (mesh) info.update(geometry_json(*mesh));
+  // A model that loaded with no OBJ statement in it is a PLY, STL or glTF file: its statement
+  // counts and MTL libraries mean nothing, and its materials come from the loaded mesh.
+  bool obj = !mesh || scan.positions > 0 || scan.faces > 0 || !scan.libraries.empty();
+  if (!obj) {
+    ojson materials = ojson::array();
+    for (const Material& m : mesh->materials) {
+      materials.push_back({{"name", m.name},
+                           {"diffuse", vec3_json(m.diffuse)},
+                           {"diffuse_map_loaded", m.diffuse_map != nullptr},
+                           {"pbr", m.pbr.has_value()},
+                           {"maps", ojson::array()}});
+    }
+    info["materials"] = std::move(materials);
+    return info;
+  }
   info["file"] = {{"positions", scan.positions},
                   {"texcoords", scan.texcoords},
                   {"normals", scan.normals},
@@ -238,30 +253,42 @@ std::string found_text(const ojson& r) {
 }
 
 void print_geometry(const ojson& info) {
-  const ojson& f = info["file"];
   std::printf("  triangles  %s\n", info["triangles"].dump().c_str());
-  std::printf(
-      "  vertices   %s (the file: %s positions, %s texture coordinates, %s normals, %s "
-      "faces)\n",
-      info["vertices"].dump().c_str(), f["positions"].dump().c_str(), f["texcoords"].dump().c_str(),
-      f["normals"].dump().c_str(), f["faces"].dump().c_str());
+  if (info.contains("file")) {  // an OBJ: what its statements count
+    const ojson& f = info["file"];
+    std::printf(
+        "  vertices   %s (the file: %s positions, %s texture coordinates, %s normals, %s "
+        "faces)\n",
+        info["vertices"].dump().c_str(), f["positions"].dump().c_str(),
+        f["texcoords"].dump().c_str(), f["normals"].dump().c_str(), f["faces"].dump().c_str());
+  } else {
+    std::printf("  vertices   %s\n", info["vertices"].dump().c_str());
+  }
   const ojson& b = info["bounds"];
   std::printf("  bounds     min %s  max %s  size %s  center %s\n", triple(b["min"]).c_str(),
               triple(b["max"]).c_str(), triple(b["size"]).c_str(), triple(b["center"]).c_str());
   std::printf("  submeshes  %zu\n", info["submeshes"].size());
   for (const ojson& s : info["submeshes"]) {
-    std::string name =
-        s["material"].is_null() ? "(default material)" : s["material"].get<std::string>();
+    std::string name = s["material"].is_null() ? "(default material)"
+                       : s["material"].get<std::string>().empty()
+                           ? "(unnamed material)"
+                           : s["material"].get<std::string>();
     std::printf("    %s: %s triangles\n", name.c_str(), s["triangles"].dump().c_str());
   }
 }
 
 void print_references(const ojson& info) {
-  for (const ojson& r : info["libraries"]) std::printf("  mtllib     %s\n", found_text(r).c_str());
+  if (info.contains("libraries")) {
+    for (const ojson& r : info["libraries"])
+      std::printf("  mtllib     %s\n", found_text(r).c_str());
+  }
   std::printf("  materials  %zu\n", info["materials"].size());
   for (const ojson& m : info["materials"]) {
     std::string kd = m.contains("diffuse") ? "  Kd " + triple(m["diffuse"]) : "";
-    std::printf("    %s%s\n", m["name"].get<std::string>().c_str(), kd.c_str());
+    if (m.contains("pbr") && m["pbr"].get<bool>()) kd += "  (metallic-roughness)";
+    if (m.contains("pbr") && m["diffuse_map_loaded"].get<bool>()) kd += "  base colour map";
+    std::string name = m["name"].get<std::string>();
+    std::printf("    %s%s\n", name.empty() ? "(unnamed)" : name.c_str(), kd.c_str());
     if (m.contains("uv_scale") &&
         (m["uv_scale"] != ojson::array({1, 1}) || m["uv_offset"] != ojson::array({0, 0}) ||
          m["clamp_maps"].get<bool>())) {
@@ -281,17 +308,18 @@ void print_references(const ojson& info) {
 void print_text(const ojson& info) {
   std::printf("%s\n", info["model"].get<std::string>().c_str());
   if (info.contains("triangles")) print_geometry(info);
-  if (info.contains("libraries")) print_references(info);
+  if (info.contains("materials")) print_references(info);
 }
 
 }  // namespace
 
 void define_info_flags(CLI::App& app, InfoArgs& a) {
-  app.add_option("MODEL", a.models, "Wavefront OBJ files")->required();
+  app.add_option("MODEL", a.models, "Model files: OBJ, PLY, STL or glTF")->required();
   app.add_flag("--json", a.json,
                "One JSON object per model and line: model, triangles, vertices, bounds (min, max, "
-               "size, center), submeshes, file (statement counts), libraries and materials with "
-               "their maps (path, resolved, found), or error");
+               "size, center), submeshes, and for OBJ files file (statement counts), libraries "
+               "and materials with their maps (path, resolved, found); for PLY, STL and glTF the "
+               "loaded materials (name, diffuse, pbr); or error");
   app.footer(
       "Vertices are the mesh's (one per distinct position/normal/uv corner), triangles after "
       "fan triangulation. Files a model names are looked up as the loader does (MTL libraries "
