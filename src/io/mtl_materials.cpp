@@ -74,13 +74,11 @@ std::string complete_map_options(std::string_view line) {
     float ignored = 0.0f;
     return !w.empty() && parse_obj_float(w, ignored) == ObjNumber::kOk;
   };
+  // Map statements: map_Kd, map_Bump, ... and the older bump, disp, decal, refl, norm.
   std::string_view statement = next_word();
-  static constexpr std::string_view kMaps[] = {
-      "map_Ka", "map_Kd", "map_Ks", "map_Ns", "map_d",  "map_Bump", "map_bump", "bump",
-      "norm",   "disp",   "decal",  "refl",   "map_Pr", "map_Pm",   "map_Ps",   "map_Ke"};
-  if (std::find(std::begin(kMaps), std::end(kMaps), statement) == std::end(kMaps)) {
-    return std::string(line);
-  }
+  bool map = statement.starts_with("map_") || statement == "bump" || statement == "disp" ||
+             statement == "decal" || statement == "refl" || statement == "norm";
+  if (!map) return std::string(line);
   std::string out(line.substr(0, at));
   for (;;) {
     size_t word_start = at;

@@ -2,6 +2,7 @@
 #include "raster/setup.hpp"
 
 #include "core/check.hpp"
+#include "core/unit_scale.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -65,10 +66,8 @@ Plane to_float(const DepthPlane& p) {
 // the fragment stage's floor of 1e-30 where w is larger (a model in units of 1e30, whose
 // interpolated colours came out 0.37 times too dark), or into float's denormals.
 [[gnu::cold, gnu::noinline]] void scale_inv_w(double* inv_w, int count) {
-  double largest = *std::max_element(inv_w, inv_w + count);
-  int exponent = 0;
-  std::frexp(largest, &exponent);
-  for (int k = 0; k < count; ++k) inv_w[k] = std::ldexp(inv_w[k], -exponent);
+  const double scale = unit_scale(*std::max_element(inv_w, inv_w + count));
+  for (int k = 0; k < count; ++k) inv_w[k] *= scale;
 }
 template <int kCount>
 void scaled_inv_w(const float (&in)[kCount], double (&out)[kCount]) {

@@ -3,6 +3,8 @@
 
 #include "shaders/pbr_render.hpp"
 
+#include "core/unit_scale.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -68,9 +70,7 @@ float shading_scale(const Camera& camera, const RenderOptions& opt) {
   float nearest = std::abs(camera.near_plane);
   if (!std::isfinite(largest) || largest == 0.0f) return 1.0f;
   if (largest <= 0x1p32f && nearest >= 0x1p-32f) return 1.0f;
-  int exponent = 0;
-  std::frexp(largest, &exponent);
-  return std::ldexp(1.0f, -exponent);
+  return unit_scale(largest);
 }
 
 void render_pbr(Framebuffer& fb, const Mesh& mesh, const Camera& camera, const glm::mat4& mvp,

@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "core/unit_scale.hpp"
 #include "shaders/builtin_shaders.hpp"
 #include "softrast/framebuffer.hpp"
 
@@ -51,9 +52,7 @@ ShadowMap build_shadow_map(const Mesh& mesh, glm::vec3 towards_light, int size, 
                             std::abs(box.hi.x), std::abs(box.hi.y), std::abs(box.hi.z)});
   float unit = 1.0f;
   if (std::isfinite(largest) && largest > 0.0f && (largest > 0x1p20f || largest < 0x1p-20f)) {
-    int exponent = 0;
-    std::frexp(largest, &exponent);
-    unit = std::ldexp(1.0f, -exponent);
+    unit = unit_scale(largest);
     box.lo *= unit;
     box.hi *= unit;
   }
