@@ -2,14 +2,17 @@
 // the scalar front end they replace: for every triangle of a group, the same decision (nothing,
 // the scalar path, or set up) as WindowVertices::triangle, culling and setup_triangle_coverage
 // make, and for a set-up triangle the same coverage, bit for bit: clockwise vertices, edge
-// functions with the fill rule, bounds inside the scissor, the 32-bit flag and the signed area;
-// except that the kernel drops the tiny triangles that cover no pixel, exactly those.
+// functions with the fill rule, bounds inside the scissor, the 32-bit flag and the signed area,
+// and the plane equations of setup_triangle_interpolants (or, where 1/w needs rescaling, the
+// scalar setup's); except that the kernel drops the tiny triangles that cover no pixel, exactly
+// those.
 // Then whole draws with culling through the binned path at every level against the reference
 // path.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
@@ -22,9 +25,11 @@
 namespace softrast {
 namespace {
 
-// Clip-space vertices (x, y, z, w, one varying): mostly inside the view, and some of each kind
-// the front end treats apart: beyond the guard band, behind the eye, NaN and Inf, exactly on
-// planes, snapped onto the same point (zero area), and triangles larger than the 32-bit path's.
+// Clip-space vertices (x, y, z, w, kKernelVaryings varyings): mostly inside the view, and some of
+// each kind the front end treats apart: beyond the guard band, behind the eye, NaN and Inf,
+// exactly on planes, snapped onto the same point (zero area), triangles larger than the 32-bit
+// path's, and 1/w outside [2^-20, 2^20] (planes rescaled by the scalar setup).
+constexpr int kKernelVaryings = 6;  // one group of four and a partial one
 std::vector<float> kernel_vertices(int count, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
@@ -35,8 +40,9 @@ std::vector<float> kernel_vertices(int count, unsigned seed) {
     // Clustered: neighbouring vertices are near each other, so most triangles are small.
     float cx = 0.9f * std::sin(float(i / 16)), cy = 0.9f * std::cos(float(i / 16) * 1.7f);
     float spread = (i / 64) % 3 == 0 ? 0.9f : 0.01f;
-    float p[5] = {(cx + spread * unit(rng)) * w, (cy + spread * unit(rng)) * w, unit(rng) * w, w,
-                  unit(rng)};
+    float p[4 + kKernelVaryings] = {(cx + spread * unit(rng)) * w, (cy + spread * unit(rng)) * w,
+                                    unit(rng) * w, w};
+    for (int i = 0; i < kKernelVaryings; ++i) p[4 + i] = unit(rng) * float(1 << (4 * i));
     switch (i % 29) {
       case 1:
         p[0] *= 5000.0f;  // beyond the guard band
@@ -56,10 +62,14 @@ std::vector<float> kernel_vertices(int count, unsigned seed) {
       case 6:
         p[1] = std::numeric_limits<float>::infinity();
         break;
+      case 7:
+      case 8:  // the same point in tiny or huge units: 1/w above 2^20 or below 2^-20
+        for (int k = 0; k < 4; ++k) p[k] *= i % 29 == 7 ? 1e-7f : 4e6f;
+        break;
       default:
         break;
     }
-    v.insert(v.end(), p, p + 5);
+    v.insert(v.end(), p, p + 4 + kKernelVaryings);
   }
   return v;
 }
@@ -82,7 +92,7 @@ bool covers_a_pixel(const detail::TriangleCoverage& c) {
 TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
   const int kVertices = 3000;
   std::vector<float> data = kernel_vertices(kVertices, 11);
-  detail::ClipVertices clip{data.data(), size_t(kVertices), 5, 1};
+  detail::ClipVertices clip{data.data(), size_t(kVertices), 4 + kKernelVaryings, kKernelVaryings};
   // Triangles of nearby vertices, a few far apart, and indices out of range.
   std::mt19937 rng(5);
   std::vector<uint32_t> indices;
@@ -97,7 +107,8 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
       indices.push_back(i);
     }
   }
-  int checked_ready = 0, checked_scalar = 0, checked_none = 0, checked_dropped = 0;
+  int checked_ready = 0, checked_scalar = 0, checked_none = 0, checked_dropped = 0,
+      checked_rescaled = 0;
   for (SimdLevel level : {SimdLevel::kAvx2, SimdLevel::kAvx512}) {
     if (cpu_simd_level() < level) continue;
     const detail::TriangleKernel kernel = detail::triangle_kernel(level);
@@ -118,6 +129,9 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
             batch.cull = cull;
             batch.front_face = face;
             batch.scissor = scissor;
+            batch.varyings = geometry.varyings(0);
+            batch.stride = geometry.stride();
+            batch.num_varyings = geometry.num_varyings();
             // Groups at every offset modulo the width, and short ones.
             for (size_t first = 0; first < size_t(kTriangles);) {
               int count = int(std::min<size_t>(kernel.lanes - (first % 3 == 0 ? first % 5 : 0),
@@ -199,6 +213,35 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
                 bool small = extent(want.vx) <= detail::kSmallTriangleFx8 &&
                              extent(want.vy) <= detail::kSmallTriangleFx8;
                 EXPECT_EQ(bool((lanes.small >> l) & 1u), small);
+                // The planes, bit for bit, except where setup rescales 1/w: the scalar setup's.
+                float largest = std::max({ordered[0]->inv_w, ordered[1]->inv_w, ordered[2]->inv_w});
+                const bool rescaled = !(largest <= 0x1p20f && largest >= 0x1p-20f);
+                EXPECT_EQ(bool((lanes.scalar_planes >> l) & 1u), rescaled);
+                if (rescaled) {
+                  ++checked_rescaled;
+                } else {
+                  detail::Interpolants in;
+                  detail::setup_triangle_interpolants(ordered, kKernelVaryings, area, face, in);
+                  auto same = [](auto a, auto b) {
+                    static_assert(sizeof a == sizeof b);
+                    return std::memcmp(&a, &b, sizeof a) == 0;
+                  };
+                  EXPECT_TRUE(same(lanes.x_ref[l], in.x_ref) && same(lanes.y_ref[l], in.y_ref));
+                  const double z[3] = {in.z.a0, in.z.dadx, in.z.dady};
+                  const float inv_w[3] = {in.inv_w.a0, in.inv_w.dadx, in.inv_w.dady};
+                  for (int c = 0; c < 3; ++c) {
+                    EXPECT_TRUE(same(lanes.z[c][l], z[c])) << lanes.z[c][l] << " " << z[c];
+                    EXPECT_TRUE(same(lanes.inv_w[c][l], inv_w[c]))
+                        << lanes.inv_w[c][l] << " " << inv_w[c];
+                  }
+                  for (int i = 0; i < kKernelVaryings; ++i) {
+                    const float var[3] = {in.var[i].a0, in.var[i].dadx, in.var[i].dady};
+                    for (int c = 0; c < 3; ++c) {
+                      EXPECT_TRUE(same(lanes.var[i][c][l], var[c]))
+                          << "varying " << i << ": " << lanes.var[i][c][l] << " " << var[c];
+                    }
+                  }
+                }
                 if (::testing::Test::HasFailure()) return;
               }
               first += size_t(count);
@@ -214,6 +257,7 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
   EXPECT_GT(checked_scalar, 1000);
   EXPECT_GT(checked_none, 10000);
   EXPECT_GT(checked_dropped, 1000);
+  EXPECT_GT(checked_rescaled, 100);
 }
 
 // Flat-coloured triangles of both facings, some crossing the near plane and the image border,

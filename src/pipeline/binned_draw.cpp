@@ -6,8 +6,9 @@
 //      each chunk (one thread at a time) trivially accepts triangles whose three vertices are
 //      inside the clip volume (guard band, near, far) and clips the others, culls by the snapped
 //      area, sets up a compact record (triangle_record.hpp) in the chunk's arena and appends its
-//      offset to the bin of every tile its bounds touch. At AVX2 and AVX-512 the accept, the cull
-//      and the coverage (edges, bounds) take 8 or 16 triangles at once (triangle_kernels.hpp).
+//      offset to the bin of every tile its bounds touch. At AVX2 and AVX-512 the accept, the cull,
+//      the coverage (edges, bounds) and the planes take 8 or 16 triangles at once
+//      (triangle_kernels.hpp).
 //   2. Raster: each tile (one thread at a time) walks the bins of all chunks in chunk order, so
 //      every pixel sees its triangles in submission order and blending stays order-correct; the
 //      tile is the raster region, so no two threads ever touch the same pixel. Deferrable draws
@@ -165,6 +166,9 @@ class BinnedDraw {
       batch.cull = state_.cull;
       batch.front_face = state_.front_face;
       batch.scissor = geometry_.scissor();
+      batch.varyings = geometry_.varyings(0);
+      batch.stride = geometry_.stride();
+      batch.num_varyings = geometry_.num_varyings();
       TriangleLanes lanes;
       const size_t width = size_t(triangle_kernel_.lanes);
       for (size_t t = begin; t < end; t += width) {
@@ -188,17 +192,32 @@ class BinnedDraw {
     uint32_t offset = chunk.records.allocate(record_bytes_);
     TriRecord* rec = chunk.records.at(offset);  // every field is written below
     TriangleCoverage& t = rec->coverage;
-    WindowVertex v[3];
     for (int k = 0; k < 3; ++k) {
       t.vx[k] = lanes.x[k][l];
       t.vy[k] = lanes.y[k][l];
       t.edge[k] = {lanes.edge_a[k][l], lanes.edge_b[k][l], lanes.edge_c[k][l]};
-      v[k] = cache_.vertices.vertex(geometry_, lanes.vertex[k][l]);
     }
     t.bounds = {lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l], lanes.bounds[3][l]};
     rec->small = (lanes.small >> l) & 1u;
-    const WindowVertex* ordered[3] = {&v[0], &v[1], &v[2]};
-    finish_record(chunk, offset, ordered, lanes.area[l]);
+    if ((lanes.scalar_planes >> l) & 1u) {
+      WindowVertex v[3];
+      for (int k = 0; k < 3; ++k) v[k] = cache_.vertices.vertex(geometry_, lanes.vertex[k][l]);
+      const WindowVertex* ordered[3] = {&v[0], &v[1], &v[2]};
+      finish_record(chunk, offset, ordered, lanes.area[l]);
+      return;
+    }
+    // The kernel's planes (the same bits as setup_triangle_interpolants').
+    Interpolants& in = rec->interp();
+    in.x_ref = lanes.x_ref[l];
+    in.y_ref = lanes.y_ref[l];
+    in.z = {lanes.z[0][l], lanes.z[1][l], lanes.z[2][l]};
+    in.inv_w = {lanes.inv_w[0][l], lanes.inv_w[1][l], lanes.inv_w[2][l]};
+    in.num_varyings = geometry_.num_varyings();
+    in.front_facing = is_front_facing(lanes.area[l], state_.front_face);
+    for (int i = 0; i < in.num_varyings; ++i) {
+      in.var[i] = {lanes.var[i][0][l], lanes.var[i][1][l], lanes.var[i][2][l]};
+    }
+    bin(chunk, t.bounds, offset);
   }
 
   // Both paths end here: the record's interpolants (from the clockwise-ordered vertices) and its

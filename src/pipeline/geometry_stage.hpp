@@ -78,6 +78,7 @@ class GeometryStage {
   // Vertex i in window space, exactly as triangle() makes it; precondition: vertex_code(i) == 0.
   WindowVertex window_vertex(uint32_t i) const { return window(vertex(i)); }
   const float* varyings(uint32_t i) const { return vertex(i) + 4; }
+  size_t stride() const { return size_t(vertices_.stride); }  // floats from vertex i to i + 1
   // The same for many vertices at once (vertex_kernels.hpp), writing to `codes` and `window`.
   VertexBatch vertex_batch(uint8_t* codes, PackedVertex* window) const {
     VertexBatch b;

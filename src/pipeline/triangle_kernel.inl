@@ -8,6 +8,7 @@ typedef int32_t I __attribute__((vector_size(4 * kL)));
 typedef uint32_t U __attribute__((vector_size(4 * kL)));
 typedef double D __attribute__((vector_size(8 * kL)));
 typedef int64_t Q __attribute__((vector_size(8 * kL)));
+typedef float F __attribute__((vector_size(4 * kL)));
 
 // Bit l set where lane l of the mask (0 or -1) is set.
 [[gnu::always_inline]] inline uint32_t lane_bits(I mask) {
@@ -64,6 +65,156 @@ typedef int64_t Q __attribute__((vector_size(8 * kL)));
 #define SOFTRAST_EXACT_INT64(v) (Q((v) + (D{} + 0x1.8p52)) - Q(D{} + 0x1.8p52))
 // A 64-bit lane mask (0 or -1) as a 32-bit one.
 #define SOFTRAST_NARROW(mask) __builtin_convertvector((mask), I)
+
+// Four consecutive floats of every lane, from at[l] (the first `count` of them; the others 0,
+// not read), as four vectors: out[f] lane l = at[l][f]. One 128-bit load per lane, then a 4x4
+// transpose within each 128-bit part: part c of the vector m holds lane 4c + m.
+[[gnu::always_inline]] inline void load_quads(const float* const* at, int count, F (&out)[4]) {
+#if SOFTRAST_TRIANGLE_LANES == 16
+  const __mmask8 mask = __mmask8((1u << count) - 1);
+  auto quad = [&](int l) { return _mm_maskz_loadu_ps(mask, at[l]); };
+  __m512 m[4];
+  for (int k = 0; k < 4; ++k) {
+    m[k] = _mm512_insertf32x4(
+        _mm512_insertf32x4(_mm512_insertf32x4(_mm512_zextps128_ps512(quad(k)), quad(k + 4), 1),
+                           quad(k + 8), 2),
+        quad(k + 12), 3);
+  }
+  const __m512d t0 = _mm512_castps_pd(_mm512_unpacklo_ps(m[0], m[1]));
+  const __m512d t1 = _mm512_castps_pd(_mm512_unpackhi_ps(m[0], m[1]));
+  const __m512d t2 = _mm512_castps_pd(_mm512_unpacklo_ps(m[2], m[3]));
+  const __m512d t3 = _mm512_castps_pd(_mm512_unpackhi_ps(m[2], m[3]));
+  out[0] = F(_mm512_castpd_ps(_mm512_unpacklo_pd(t0, t2)));
+  out[1] = F(_mm512_castpd_ps(_mm512_unpackhi_pd(t0, t2)));
+  out[2] = F(_mm512_castpd_ps(_mm512_unpacklo_pd(t1, t3)));
+  out[3] = F(_mm512_castpd_ps(_mm512_unpackhi_pd(t1, t3)));
+#else
+  const __m128i mask = _mm_cmpgt_epi32(_mm_set1_epi32(count), _mm_setr_epi32(0, 1, 2, 3));
+  auto quad = [&](int l) { return _mm_maskload_ps(at[l], mask); };
+  __m256 m[4];
+  for (int k = 0; k < 4; ++k) m[k] = _mm256_set_m128(quad(k + 4), quad(k));
+  const __m256d t0 = _mm256_castps_pd(_mm256_unpacklo_ps(m[0], m[1]));
+  const __m256d t1 = _mm256_castps_pd(_mm256_unpackhi_ps(m[0], m[1]));
+  const __m256d t2 = _mm256_castps_pd(_mm256_unpacklo_ps(m[2], m[3]));
+  const __m256d t3 = _mm256_castps_pd(_mm256_unpackhi_ps(m[2], m[3]));
+  out[0] = F(_mm256_castpd_ps(_mm256_unpacklo_pd(t0, t2)));
+  out[1] = F(_mm256_castpd_ps(_mm256_unpackhi_pd(t0, t2)));
+  out[2] = F(_mm256_castpd_ps(_mm256_unpacklo_pd(t1, t3)));
+  out[3] = F(_mm256_castpd_ps(_mm256_unpackhi_pd(t1, t3)));
+#endif
+}
+
+// setup_planes (raster/setup.cpp) for every lane: the same double operations in the same order,
+// so the same bits where a lane is ready. Half the lanes at a time, in vectors of one register
+// (GCC splits wider double vectors, and turns their compares and selects into scalar code).
+// out.vertex, out.x, out.y, out.area: the clockwise vertices and the signed snapped area.
+typedef double DH __attribute__((vector_size(4 * kL)));
+typedef float FH __attribute__((vector_size(2 * kL)));
+typedef int32_t IH __attribute__((vector_size(2 * kL)));
+typedef int64_t QH __attribute__((vector_size(4 * kL)));
+constexpr int kH = kL / 2;
+
+// The first or second half (h) of a row of kL values as a vector of kH.
+template <class V, class T>
+[[gnu::always_inline]] inline V half(const T* row, int h) {
+  V v;
+  std::memcpy(&v, row + h * kH, sizeof v);
+  return v;
+}
+template <class T, class V>
+[[gnu::always_inline]] inline void store_half(T* row, int h, const V& v) {
+  std::memcpy(row + h * kH, &v, sizeof v);
+}
+
+[[gnu::always_inline]] inline void setup_plane_lanes(const TriangleBatch& b, TriangleLanes& out) {
+  // z, 1/w and the residuals of each vertex (PackedVertex's floats 2 to 5), by lane.
+  alignas(64) float vertex_floats[3][4][kL];
+  for (int k = 0; k < 3; ++k) {
+    const float* at[kL];
+    for (int l = 0; l < kL; ++l) at[l] = &b.window[out.vertex[k][l]].z;
+    F q[4];
+    load_quads(at, 4, q);
+    for (int f = 0; f < 4; ++f) std::memcpy(vertex_floats[k][f], &q[f], sizeof q[f]);
+  }
+  // The varyings, by lane: var_floats[k][i] for vertex k's varying i.
+  alignas(64) float var_floats[3][kMaxVaryings][kL];
+  for (int first = 0; first < b.num_varyings; first += 4) {
+    const int count = std::min(4, b.num_varyings - first);
+    for (int k = 0; k < 3; ++k) {
+      const float* at[kL];
+      for (int l = 0; l < kL; ++l) at[l] = b.varyings + size_t(out.vertex[k][l]) * b.stride + first;
+      F q[4];
+      load_quads(at, count, q);
+      for (int f = 0; f < count; ++f) std::memcpy(var_floats[k][first + f], &q[f], sizeof q[f]);
+    }
+  }
+  out.scalar_planes = 0;
+  for (int h = 0; h < 2; ++h) {
+// (Macros, not lambdas: GCC gives a lambda that returns a vector the default target's ABI.)
+#define SOFTRAST_HALF_DOUBLE(v) __builtin_convertvector((v), DH)
+#define SOFTRAST_HALF_FLOAT(v) __builtin_convertvector((v), FH)
+#define SOFTRAST_FIELD(k, f) SOFTRAST_HALF_DOUBLE(half<FH>(vertex_floats[k][f], h))
+    // scaled_inv_w: lanes whose largest 1/w (in std::max's order) is outside [2^-20, 2^20] go to
+    // the scalar setup, which rescales it.
+    FH largest = half<FH>(vertex_floats[0][1], h);
+    for (int k = 0; k < 3; ++k) {
+      const FH w = half<FH>(vertex_floats[k][1], h);
+      largest = largest < w ? w : largest;
+    }
+    const IH in_range = (largest <= 0x1p20f) & (largest >= 0x1p-20f);
+    for (int l = 0; l < kH; ++l) out.scalar_planes |= uint32_t(in_range[l] == 0) << (h * kH + l);
+
+    // The snapped basis (to_pixels: times 2^-8, exact) and the exact one (the residuals).
+    const DH px = DH{} + 0x1p-8;
+    const IH x0 = half<IH>(out.x[0], h), y0 = half<IH>(out.y[0], h);
+    const DH gdx1 = SOFTRAST_HALF_DOUBLE(half<IH>(out.x[1], h) - x0) * px;
+    const DH gdx2 = SOFTRAST_HALF_DOUBLE(half<IH>(out.x[2], h) - x0) * px;
+    const DH gdy1 = SOFTRAST_HALF_DOUBLE(half<IH>(out.y[1], h) - y0) * px;
+    const DH gdy2 = SOFTRAST_HALF_DOUBLE(half<IH>(out.y[2], h) - y0) * px;
+    const DH rx0 = px * SOFTRAST_FIELD(0, 2), ry0 = px * SOFTRAST_FIELD(0, 3);
+    const DH edx1 = gdx1 + (px * SOFTRAST_FIELD(1, 2) - rx0),
+             edx2 = gdx2 + (px * SOFTRAST_FIELD(2, 2) - rx0);
+    const DH edy1 = gdy1 + (px * SOFTRAST_FIELD(1, 3) - ry0),
+             edy2 = gdy2 + (px * SOFTRAST_FIELD(2, 3) - ry0);
+    const DH exact_area2 = edx1 * edy2 - edx2 * edy1;
+    // double(|area|): the area is an integer below 2^49, exact through 1.5 * 2^52.
+    const QH area = half<QH>(out.area, h);
+    const DH abs_area = DH((area < 0 ? -area : area) + QH(DH{} + 0x1.8p52)) - (DH{} + 0x1.8p52);
+    const QH moved = (rx0 != 0.0) | (ry0 != 0.0) | (edx1 != gdx1) | (edx2 != gdx2) |
+                     (edy1 != gdy1) | (edy2 != gdy2);
+    const QH exact = moved & (exact_area2 >= (abs_area * 0x1p-16) * (1.0 / 16.0));
+    const DH inv_area2 = (exact ? DH{} + 1.0 : DH{} + 65536.0) / (exact ? exact_area2 : abs_area);
+    const DH dx1 = exact ? edx1 : gdx1, dx2 = exact ? edx2 : gdx2;
+    const DH dy1 = exact ? edy1 : gdy1, dy2 = exact ? edy2 : gdy2;
+    const DH ox = exact ? rx0 : DH{}, oy = exact ? ry0 : DH{};
+    const QH shifted = (ox != 0.0) | (oy != 0.0);
+    // make_plane.
+    auto plane = [&](const DH& a0, const DH& a1, const DH& a2, DH& p0, DH& pdx, DH& pdy) {
+      const DH da1 = a1 - a0, da2 = a2 - a0;
+      pdx = (da1 * dy2 - da2 * dy1) * inv_area2;
+      pdy = (da2 * dx1 - da1 * dx2) * inv_area2;
+      p0 = shifted ? a0 - pdx * ox - pdy * oy : a0;
+    };
+    store_half(out.x_ref, h, SOFTRAST_HALF_FLOAT(SOFTRAST_HALF_DOUBLE(x0) * px));
+    store_half(out.y_ref, h, SOFTRAST_HALF_FLOAT(SOFTRAST_HALF_DOUBLE(y0) * px));
+    DH p[3];
+    plane(SOFTRAST_FIELD(0, 0), SOFTRAST_FIELD(1, 0), SOFTRAST_FIELD(2, 0), p[0], p[1], p[2]);
+    for (int c = 0; c < 3; ++c) store_half(out.z[c], h, p[c]);
+    const DH w[3] = {SOFTRAST_FIELD(0, 1), SOFTRAST_FIELD(1, 1), SOFTRAST_FIELD(2, 1)};
+    plane(w[0], w[1], w[2], p[0], p[1], p[2]);
+    for (int c = 0; c < 3; ++c) store_half(out.inv_w[c], h, SOFTRAST_HALF_FLOAT(p[c]));
+    for (int i = 0; i < b.num_varyings; ++i) {
+#define SOFTRAST_VAR(k) SOFTRAST_HALF_DOUBLE(half<FH>(var_floats[k][i], h)) * w[k]
+      plane(SOFTRAST_VAR(0), SOFTRAST_VAR(1), SOFTRAST_VAR(2), p[0], p[1], p[2]);
+#undef SOFTRAST_VAR
+      for (int c = 0; c < 3; ++c) store_half(out.var[i][c], h, SOFTRAST_HALF_FLOAT(p[c]));
+    }
+  }
+  out.scalar_planes &= out.ready;
+}
+#undef SOFTRAST_HALF_DOUBLE
+#undef SOFTRAST_HALF_FLOAT
+#undef SOFTRAST_FIELD
 
 void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLanes& out) {
   const uint32_t* p = b.indices + 3 * first;
@@ -194,6 +345,7 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
     std::memcpy(out.edge_b[k], &edge_b[k], sizeof edge_b[k]);
     std::memcpy(out.edge_c[k], &edge_c[k], sizeof edge_c[k]);
   }
+  if (out.ready != 0) setup_plane_lanes(b, out);
 }
 
 #undef SOFTRAST_TO_DOUBLE

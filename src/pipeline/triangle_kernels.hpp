@@ -9,7 +9,9 @@
 // functions with the fill rule and the 32-bit flag. Bit for bit what setup_triangle_coverage
 // computes (tests/triangle_kernel_test.cpp): every quantity is an integer, and the products and
 // sums of 16.8 coordinates are exact in double (below 2^49, fixed_point.hpp), so they are
-// computed in double lanes and converted back exactly.
+// computed in double lanes and converted back exactly. Then the plane equations of the set-up
+// triangles (setup_triangle_interpolants): the same IEEE double operations in the same order,
+// lane by lane, so the same bits (the build does not fuse multiplies and adds).
 #pragma once
 
 #include <cstddef>
@@ -27,6 +29,10 @@ struct TriangleBatch {
   const uint32_t* indices = nullptr;     // three per triangle
   size_t vertex_count = 0;               // indices at or past it skip their triangle
   const PackedVertex* window = nullptr;  // x is kOutsideVolume where the vertex code is not 0
+  // Vertex i's varyings (GeometryStage::varyings): num_varyings floats at varyings + i * stride.
+  const float* varyings = nullptr;
+  size_t stride = 0;
+  int num_varyings = 0;
   CullMode cull = CullMode::kNone;
   FrontFace front_face = FrontFace::kCounterClockwise;
   PixelRect scissor;
@@ -48,6 +54,15 @@ struct TriangleLanes {
   alignas(64) int64_t edge_c[3][kMaxLanes];   // EdgeFunction::c
   alignas(64) int64_t area[kMaxLanes];        // signed_area_fx16 of the triangle as submitted
   alignas(64) int32_t bounds[4][kMaxLanes];   // x0, y0, x1, y1 (PixelRect)
+  // The Interpolants of the ready lanes but those in `scalar_planes`: a vertex's 1/w is outside
+  // [2^-20, 2^20], where setup rescales it (rare: a scene in tiny or huge units), and the scalar
+  // setup_triangle_interpolants makes them. front_facing and num_varyings are not stored.
+  uint32_t scalar_planes = 0;
+  alignas(64) float x_ref[kMaxLanes];
+  alignas(64) float y_ref[kMaxLanes];
+  alignas(64) double z[3][kMaxLanes];                 // DepthPlane a0, dadx, dady
+  alignas(64) float inv_w[3][kMaxLanes];              // Plane a0, dadx, dady
+  alignas(64) float var[kMaxVaryings][3][kMaxLanes];  // var[i]'s a0, dadx, dady
 };
 
 // Sets up triangles [first, first + count) of the batch, count <= the kernel's lanes.

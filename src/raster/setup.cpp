@@ -101,6 +101,8 @@ PixelRect triangle_bounds(const int32_t vx[3], const int32_t vy[3]) {
 // plane's value there. When snapping changed the triangle's shape so much that the exact area is
 // under a sixteenth of the snapped one (or of the other sign), the exact planes' gradients would
 // be unbounded where coverage still finds samples; those keep the snapped shape.
+// setup_plane_lanes (pipeline/triangle_kernel.inl) does the same, operation for operation, for 8
+// or 16 triangles at once: a change here is a change there (tests/triangle_kernel_test.cpp).
 void setup_planes(const WindowVertex* const v[3], int num_varyings, int64_t area_fx16,
                   Interpolants& out) {
   PlaneBasis g;
