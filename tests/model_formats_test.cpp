@@ -285,46 +285,39 @@ TEST_F(ModelFormatsTest, EveryTruncationIsAClearError) {
 }
 
 TEST_F(ModelFormatsTest, MessagesNameTheFileAndPlace) {
-  std::string p = write("a.ply",
-                        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
-                        "property float y\nproperty float z\nelement face 1\n"
-                        "property list uchar int vertex_indices\nend_header\n"
-                        "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
-  Result<Mesh> mesh = load_model(p);
-  ASSERT_FALSE(mesh.ok());
-  EXPECT_EQ(mesh.status().message(), p + ":13: face 0: vertex index 7 is out of range (0..2)");
-  p = write("b.ply",
-            "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\n"
-            "property float x\nproperty float y\nproperty float z\nend_header\n");
-  mesh = load_model(p);
-  ASSERT_FALSE(mesh.ok());
-  EXPECT_EQ(mesh.status().message(),
-            p + ": 1000000000 vertex elements need at least 12 bytes each, but 0 bytes are left "
-                "(truncated)");
-  p = write("c.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty flaot x\nend_header\n");
-  mesh = load_model(p);
-  ASSERT_FALSE(mesh.ok());
-  EXPECT_EQ(mesh.status().message(), p + ":4: unknown type 'flaot'");
+  // Loads `bytes` as file `name`; the load must fail with "<path>" + `message`.
+  auto expect_error = [&](const std::string& name, const std::string& bytes,
+                          const std::string& message) {
+    std::string p = write(name, bytes);
+    Result<Mesh> mesh = load_model(p);
+    ASSERT_FALSE(mesh.ok()) << name;
+    EXPECT_EQ(mesh.status().message(), p + message);
+  };
+  expect_error("a.ply",
+               "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+               "property float y\nproperty float z\nelement face 1\n"
+               "property list uchar int vertex_indices\nend_header\n"
+               "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n",
+               ":13: face 0: vertex index 7 is out of range (0..2)");
+  expect_error("b.ply",
+               "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\n"
+               "property float x\nproperty float y\nproperty float z\nend_header\n",
+               ": 1000000000 vertex elements need at least 12 bytes each, but 0 bytes are left "
+               "(truncated)");
+  expect_error("c.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty flaot x\nend_header\n",
+               ":4: unknown type 'flaot'");
   // A point cloud (a scanner's PLY): what it is, not only what it lacks.
-  p = write("cloud.ply",
-            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-            "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n");
-  mesh = load_model(p);
-  ASSERT_FALSE(mesh.ok());
-  EXPECT_EQ(mesh.status().message(),
-            p + ": no faces: a point cloud of 3 vertices; softrast draws faces, not points");
+  expect_error("cloud.ply",
+               "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+               "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n",
+               ": no faces: a point cloud of 3 vertices; softrast draws faces, not points");
   std::string stl = stl_binary();
-  p = write("d.stl", stl.substr(0, stl.size() - 10));
-  mesh = load_model(p);
-  ASSERT_FALSE(mesh.ok());
-  EXPECT_EQ(mesh.status().message(),
-            p + ": binary STL declares 12 triangles (684 bytes) but has 674 bytes (truncated)");
-  p = write("e.stl",
-            "solid x\n facet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n"
-            " endloop\n endfacet\nendsolid x\n");
-  mesh = load_model(p);
-  ASSERT_FALSE(mesh.ok());
-  EXPECT_EQ(mesh.status().message(), p + ":6: expected 'vertex', found 'endloop'");
+  expect_error("d.stl", stl.substr(0, stl.size() - 10),
+               ": binary STL declares 12 triangles (684 bytes) but has 674 bytes (truncated)");
+  expect_error("e.stl",
+               "solid x\n facet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n"
+               " endloop\n endfacet\nendsolid x\n",
+               ":6: expected 'vertex', found 'endloop'");
 }
 
 TEST_F(ModelFormatsTest, FilesThatAreNotModelsSayWhatTheyAre) {
