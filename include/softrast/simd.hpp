@@ -629,6 +629,23 @@ inline void lookup16(const float* table, const Native<4>::I& index, Native<4>::F
       _mm512_maskz_permutexvar_ps(__mmask16(0xffff), __m512i(index), _mm512_loadu_ps(table)));
 }
 
+// r[i] = table[index[i]] for a table of 16 doubles, indices in [0, 16): at AVX-512 (the only
+// level with this one), a two-source permute per register of doubles.
+[[gnu::target("avx512f")]] inline void lookup16(const double* table, const Native<16>::I& index,
+                                                Native<16>::D& r) {
+  using I8 = Native<8>::I;
+  using D8 = Native<8>::D;
+  const __m512d low = _mm512_loadu_pd(table), high = _mm512_loadu_pd(table + 8);
+  const I8 first = __builtin_shufflevector(index, index, 0, 1, 2, 3, 4, 5, 6, 7);
+  const I8 second = __builtin_shufflevector(index, index, 8, 9, 10, 11, 12, 13, 14, 15);
+  // (The zero-masked widening: GCC 12's unmasked one draws bug 105593's warning.)
+  const D8 a =
+      D8(_mm512_permutex2var_pd(low, _mm512_maskz_cvtepu32_epi64(0xff, __m256i(first)), high));
+  const D8 b =
+      D8(_mm512_permutex2var_pd(low, _mm512_maskz_cvtepu32_epi64(0xff, __m256i(second)), high));
+  r = __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+}
+
 // Each lane as two int16 halves: (a * b + 2^14) >> 15 half by half, the product rounded to 15
 // fraction bits (PMULHRSW, which SSE2 lacks: there the same integers from the product's halves).
 // Neither product may be (-2^15)^2.

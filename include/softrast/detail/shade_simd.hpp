@@ -378,6 +378,19 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
 // coefficient of the triangle that covers pixel l (triangle 0's where none does: finite, never
 // written). Two sources give the same values (copies, no arithmetic).
 
+// The depth of each covered pixel of a MixedBlock from its own triangle's plane, clamped to
+// [0, 1] as shade_block_wide computes it; `z` (the stored depth) elsewhere. One plane at a time.
+template <int N>
+SOFTRAST_SIMD_INLINE void mixed_depth_by_triangle(const MixedBlock& block, const simd::Float<N>& px,
+                                                  const simd::Float<N>& py, simd::Float<N>& z) {
+  using F = simd::Float<N>;
+  for (int k = 0; k < block.count; ++k) {
+    const Interpolants& in = *block.winner[k];
+    F own = eval_plane<N>(in.z, px - F(in.x_ref), py - F(in.y_ref));
+    z = simd::select(simd::lanes_of<N>(block.mask[k]), simd::clamp(own, F(0.0f), F(1.0f)), z);
+  }
+}
+
 // Any number of triangles: the coefficients as a table in memory (entry k of a row: triangle
 // k's), one permute per row.
 template <class S, int N>
@@ -387,11 +400,17 @@ struct MixedTable {
   static constexpr int kN = S::kVaryings > 0 ? S::kVaryings : 1;
   enum { kXRef, kYRef, kInvW, kVar = kInvW + 3, kRows = kVar + 3 * kN };
   alignas(64) float table[kRows][16];
+  alignas(64) double depth_table[3][16];  // the depth planes' a0, dadx, dady (AVX-512)
   I lane_winner;
 
   SOFTRAST_SIMD_INLINE explicit MixedTable(const MixedBlock& block) : lane_winner(0) {
     for (int k = 0; k < block.count; ++k) {
       const Interpolants& in = *block.winner[k];
+      if constexpr (N == 16) {
+        depth_table[0][k] = in.z.a0;
+        depth_table[1][k] = in.z.dadx;
+        depth_table[2][k] = in.z.dady;
+      }
       table[kXRef][k] = in.x_ref;
       table[kYRef][k] = in.y_ref;
       table[kInvW][k] = in.inv_w.a0;
@@ -410,6 +429,25 @@ struct MixedTable {
   SOFTRAST_SIMD_INLINE F y_ref() const { return row(kYRef); }
   SOFTRAST_SIMD_INLINE F inv_w(int j) const { return row(kInvW + j); }
   SOFTRAST_SIMD_INLINE F var(int i, int j) const { return row(kVar + 3 * i + j); }
+  // mixed_depth_by_triangle's depths of the covered pixels (dx, dy: the pixels' offsets from
+  // their own triangle's reference point). At AVX-512, each lane's plane by a permute and one
+  // evaluation, eval_plane's operations on per-lane coefficients (the same bits; uncovered lanes
+  // get triangle 0's depth, never used); elsewhere one plane at a time.
+  SOFTRAST_SIMD_INLINE void depth(const MixedBlock& block, const F& px, const F& py, const F& dx,
+                                  const F& dy, F& z) const {
+    if constexpr (N == 16) {
+      using D = typename simd::Native<N>::D;
+      D a0, dadx, dady;
+      simd::isa::lookup16(depth_table[0], lane_winner.p[0], a0);
+      simd::isa::lookup16(depth_table[1], lane_winner.p[0], dadx);
+      simd::isa::lookup16(depth_table[2], lane_winner.p[0], dady);
+      const D x = __builtin_convertvector(dx.p[0], D), y = __builtin_convertvector(dy.p[0], D);
+      z.p[0] = __builtin_convertvector((a0 + dadx * x) + dady * y, typename simd::Native<N>::F);
+      z = simd::clamp(z, F(0.0f), F(1.0f));
+    } else {
+      mixed_depth_by_triangle<N>(block, px, py, z);
+    }
+  }
 };
 
 // Two triangles (most blocks of several: a mesh's edges cut blocks in two): each coefficient
@@ -442,6 +480,10 @@ struct MixedPair {
   }
   SOFTRAST_SIMD_INLINE F var(int i, int j) const {
     return pick(coefficient(first.var[i], j), coefficient(second.var[i], j));
+  }
+  SOFTRAST_SIMD_INLINE void depth(const MixedBlock& block, const F& px, const F& py, const F&,
+                                  const F&, F& z) const {
+    mixed_depth_by_triangle<N>(block, px, py, z);
   }
 };
 
@@ -477,11 +519,7 @@ SOFTRAST_SIMD_INLINE void shade_mixed_with(const S& shader, const ShadeTarget& t
     // Immediate (the state deferred shading needs: opaque, depth test less or less-equal with
     // writes): each lane's depth from its own triangle's plane, as shade_block_wide computes it,
     // and the early test.
-    for (int k = 0; k < block.count; ++k) {
-      const Interpolants& in = *block.winner[k];
-      F own = eval_plane<N>(in.z, f.x - F(in.x_ref), f.y - F(in.y_ref));
-      z = simd::select(simd::lanes_of<N>(block.mask[k]), simd::clamp(own, F(0.0f), F(1.0f)), z);
-    }
+    coef.depth(block, f.x, f.y, dx, dy, z);
     // LESS or LEQUAL (the only tests a batch is made for), without a switch.
     I passes = z < stored;
     if (target.state->depth_func == DepthFunc::kLessEqual) passes = passes | (z == stored);
