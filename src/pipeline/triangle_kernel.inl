@@ -66,13 +66,16 @@ typedef float F __attribute__((vector_size(4 * kL)));
 // A 64-bit lane mask (0 or -1) as a 32-bit one.
 #define SOFTRAST_NARROW(mask) __builtin_convertvector((mask), I)
 
-// Four consecutive floats of every lane, from at[l] (the first `count` of them; the others 0,
-// not read), as four vectors: out[f] lane l = at[l][f]. One 128-bit load per lane, then a 4x4
-// transpose within each 128-bit part: part c of the vector m holds lane 4c + m.
-[[gnu::always_inline]] inline void load_quads(const float* const* at, int count, F (&out)[4]) {
+// Four consecutive floats of every lane, from base + index[l] * stride (the first `count` of
+// them; the others 0, not read), as four vectors: out[f] lane l = base[index[l] * stride + f].
+// One 128-bit load per lane, then a 4x4 transpose within each 128-bit part: part c of the vector
+// m holds lane 4c + m.
+[[gnu::always_inline]] inline void load_quads(const float* base, const uint32_t* index,
+                                              size_t stride, int count, F (&out)[4]) {
+  auto at = [&](int l) { return base + size_t(index[l]) * stride; };
 #if SOFTRAST_TRIANGLE_LANES == 16
   const __mmask8 mask = __mmask8((1u << count) - 1);
-  auto quad = [&](int l) { return _mm_maskz_loadu_ps(mask, at[l]); };
+  auto quad = [&](int l) { return _mm_maskz_loadu_ps(mask, at(l)); };
   __m512 m[4];
   for (int k = 0; k < 4; ++k) {
     m[k] = _mm512_insertf32x4(
@@ -90,7 +93,7 @@ typedef float F __attribute__((vector_size(4 * kL)));
   out[3] = F(_mm512_castpd_ps(_mm512_unpackhi_pd(t1, t3)));
 #else
   const __m128i mask = _mm_cmpgt_epi32(_mm_set1_epi32(count), _mm_setr_epi32(0, 1, 2, 3));
-  auto quad = [&](int l) { return _mm_maskload_ps(at[l], mask); };
+  auto quad = [&](int l) { return _mm_maskload_ps(at(l), mask); };
   __m256 m[4];
   for (int k = 0; k < 4; ++k) m[k] = _mm256_set_m128(quad(k + 4), quad(k));
   const __m256d t0 = _mm256_castps_pd(_mm256_unpacklo_ps(m[0], m[1]));
@@ -130,10 +133,9 @@ template <class T, class V>
   // z, 1/w and the residuals of each vertex (PackedVertex's floats 2 to 5), by lane.
   alignas(64) float vertex_floats[3][4][kL];
   for (int k = 0; k < 3; ++k) {
-    const float* at[kL];
-    for (int l = 0; l < kL; ++l) at[l] = &b.window[out.vertex[k][l]].z;
+    static_assert(sizeof(PackedVertex) == 6 * sizeof(float) && offsetof(PackedVertex, z) == 8);
     F q[4];
-    load_quads(at, 4, q);
+    load_quads(&b.window->z, out.vertex[k], 6, 4, q);
     for (int f = 0; f < 4; ++f) std::memcpy(vertex_floats[k][f], &q[f], sizeof q[f]);
   }
   // The varyings, by lane: var_floats[k][i] for vertex k's varying i.
@@ -141,10 +143,8 @@ template <class T, class V>
   for (int first = 0; first < b.num_varyings; first += 4) {
     const int count = std::min(4, b.num_varyings - first);
     for (int k = 0; k < 3; ++k) {
-      const float* at[kL];
-      for (int l = 0; l < kL; ++l) at[l] = b.varyings + size_t(out.vertex[k][l]) * b.stride + first;
       F q[4];
-      load_quads(at, count, q);
+      load_quads(b.varyings + first, out.vertex[k], b.stride, count, q);
       for (int f = 0; f < count; ++f) std::memcpy(var_floats[k][first + f], &q[f], sizeof q[f]);
     }
   }
