@@ -38,7 +38,8 @@ struct OneRecord {
   alignas(8) std::byte bytes[detail::record_bytes(0)];
   explicit OneRecord(const detail::TriangleSetup& tri) {
     auto* rec = new (bytes) detail::TriRecord;
-    rec->coverage = tri;
+    for (int k = 0; k < 3; ++k) rec->edge[k] = tri.edge[k];
+    rec->bounds = tri.bounds;
     auto extent = [](const int32_t v[3]) {
       return int64_t(std::max({v[0], v[1], v[2]})) - std::min({v[0], v[1], v[2]});
     };

@@ -110,7 +110,8 @@ class BinnedDraw {
     deferred_ = deferred_shading_applies(state, program);
     kernels_ = tile_kernels(simd_level());
     triangle_kernel_ = triangle_kernel(simd_level());
-    record_bytes_ = record_bytes(geometry.num_varyings());
+    scanline_ = state.raster == RasterAlgorithm::kScanline;
+    record_bytes_ = record_bytes(geometry.num_varyings(), scanline_);
     const PixelRect& s = geometry.scissor();
     tiles_x_ = (s.x1 + kTileSize - 1) / kTileSize;
     tiles_y_ = (s.y1 + kTileSize - 1) / kTileSize;
@@ -191,14 +192,15 @@ class BinnedDraw {
   void add_set_up(Chunk& chunk, const TriangleLanes& lanes, int l) {
     uint32_t offset = chunk.records.allocate(record_bytes_);
     TriRecord* rec = chunk.records.at(offset);  // every field is written below
-    TriangleCoverage& t = rec->coverage;
     for (int k = 0; k < 3; ++k) {
-      t.vx[k] = lanes.x[k][l];
-      t.vy[k] = lanes.y[k][l];
-      t.edge[k] = {lanes.edge_a[k][l], lanes.edge_b[k][l], lanes.edge_c[k][l]};
+      rec->edge[k] = {lanes.edge_a[k][l], lanes.edge_b[k][l], lanes.edge_c[k][l]};
     }
-    t.bounds = {lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l], lanes.bounds[3][l]};
+    rec->bounds = {lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l], lanes.bounds[3][l]};
     rec->small = (lanes.small >> l) & 1u;
+    if (scanline_) {
+      int32_t* v = rec->vertices(geometry_.num_varyings());
+      for (int k = 0; k < 3; ++k) v[k] = lanes.x[k][l], v[3 + k] = lanes.y[k][l];
+    }
     if ((lanes.scalar_planes >> l) & 1u) {
       WindowVertex v[3];
       for (int k = 0; k < 3; ++k) v[k] = cache_.vertices.vertex(geometry_, lanes.vertex[k][l]);
@@ -217,7 +219,7 @@ class BinnedDraw {
     for (int i = 0; i < in.num_varyings; ++i) {
       in.var[i] = {lanes.var[i][0][l], lanes.var[i][1][l], lanes.var[i][2][l]};
     }
-    bin(chunk, t.bounds, offset);
+    bin(chunk, rec->bounds, offset);
   }
 
   // Both paths end here: the record's interpolants (from the clockwise-ordered vertices) and its
@@ -227,7 +229,7 @@ class BinnedDraw {
     TriRecord* rec = chunk.records.at(offset);
     setup_triangle_interpolants(ordered, geometry_.num_varyings(), area, state_.front_face,
                                 rec->interp());
-    bin(chunk, rec->coverage.bounds, offset);
+    bin(chunk, rec->bounds, offset);
   }
 
   // Whether a triangle of snapped signed area `area` survives culling (zero area never does).
@@ -241,20 +243,23 @@ class BinnedDraw {
     // (setup_chunk), and the check passes them again. The area is needed below either way.
     int64_t area = signed_area_fx16(a, b, c);
     if (!kept(area)) return;
+    TriangleCoverage t;
+    const WindowVertex* ordered[3];
+    if (!setup_triangle_coverage(a, b, c, area, geometry_.scissor(), t, ordered)) return;
     uint32_t offset = chunk.records.allocate(record_bytes_);
     // TriRecord is an implicit-lifetime aggregate living in allocated bytes; every field is
     // written below.
     TriRecord* rec = chunk.records.at(offset);
-    const WindowVertex* ordered[3];
-    if (!setup_triangle_coverage(a, b, c, area, geometry_.scissor(), rec->coverage, ordered)) {
-      chunk.records.release_last(record_bytes_);
-      return;
-    }
-    const TriangleCoverage& t = rec->coverage;
+    for (int k = 0; k < 3; ++k) rec->edge[k] = t.edge[k];
+    rec->bounds = t.bounds;
     auto extent = [](const int32_t v[3]) {
       return int64_t(std::max({v[0], v[1], v[2]})) - std::min({v[0], v[1], v[2]});
     };
     rec->small = extent(t.vx) <= kSmallTriangleFx8 && extent(t.vy) <= kSmallTriangleFx8;
+    if (scanline_) {
+      int32_t* v = rec->vertices(geometry_.num_varyings());
+      for (int k = 0; k < 3; ++k) v[k] = t.vx[k], v[3 + k] = t.vy[k];
+    }
     finish_record(chunk, offset, ordered, area);
   }
 
@@ -385,7 +390,8 @@ class BinnedDraw {
       }
       for (uint32_t offset : bin) {
         const TriRecord& rec = record(chunk, offset);
-        rasterize_triangle_scanline(rec.coverage, job.region, shading.sink(rec.interp()));
+        rasterize_triangle_scanline(rec.coverage(geometry_.num_varyings()), job.region,
+                                    shading.sink(rec.interp()));
       }
     }
     if (job.batch != nullptr) job.batch->flush();  // the tile's last held blocks
@@ -415,7 +421,8 @@ class BinnedDraw {
         sink.plane = {in.x_ref, in.y_ref, in.z};
         sink.id = job.next_id++;
         job.interps[sink.id] = &in;
-        rasterize_triangle_scanline(rec.coverage, job.region, BlockSink{&ResolveSink::emit, &sink});
+        rasterize_triangle_scanline(rec.coverage(geometry_.num_varyings()), job.region,
+                                    BlockSink{&ResolveSink::emit, &sink});
       }
     }
     visibility.store_depth();
@@ -441,6 +448,7 @@ class BinnedDraw {
   bool deferred_ = false;
   TileKernels kernels_{};
   TriangleKernel triangle_kernel_{};
+  bool scanline_ = false;  // records hold their vertices (RasterAlgorithm::kScanline)
   size_t record_bytes_ = 0;
   size_t num_chunks_ = 1;
   int tiles_x_ = 0, tiles_y_ = 0;

@@ -41,7 +41,7 @@ struct EdgeOffsets {
 };
 
 template <class V, class T>
-[[gnu::always_inline]] inline void make_offsets(const TriangleCoverage& t, EdgeOffsets<V>& o) {
+[[gnu::always_inline]] inline void make_offsets(const TriRecord& t, EdgeOffsets<V>& o) {
   for (int g = 0; g < kGroups; ++g) {
     I p = pixel_index(g);
     V column = __builtin_convertvector(p & 3, V), row = __builtin_convertvector(p >> 2, V);
@@ -321,7 +321,7 @@ struct BlockTarget {
 struct EdgeExtents {
   int64_t lo[3], hi[3];  // added to E at the block's first sample: its minimum and maximum
 };
-[[gnu::always_inline]] inline EdgeExtents edge_extents(const TriangleCoverage& t, int size) {
+[[gnu::always_inline]] inline EdgeExtents edge_extents(const TriRecord& t, int size) {
   EdgeExtents x;
   int64_t span = int64_t(size - 1) * kSubpixelOne;
   for (int k = 0; k < 3; ++k) {
@@ -356,7 +356,7 @@ template <Mode kMode, class V, class T>
 [[gnu::always_inline]] inline void raster_record_with(TileJob& job, const TriRecord& rec,
                                                       int32_t id, const PixelRect& area,
                                                       const EdgeGrid& grid) {
-  const TriangleCoverage& t = rec.coverage;
+  const TriRecord& t = rec;
   BlockTarget<kMode> emit(job, rec, id, area);
   EdgeOffsets<V> offsets;
   make_offsets<V, T>(t, offsets);
@@ -416,7 +416,7 @@ template <Mode kMode, class V, class T>
 
 template <Mode kMode>
 [[gnu::always_inline]] inline void raster_record(TileJob& job, const TriRecord& rec, int32_t id) {
-  const TriangleCoverage& t = rec.coverage;
+  const TriRecord& t = rec;
   PixelRect area = intersect(t.bounds, job.region);
   if (area.empty()) return;
   EdgeGrid grid;

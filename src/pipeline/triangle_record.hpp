@@ -12,23 +12,53 @@
 
 namespace softrast::detail {
 
-// One triangle as binned: its coverage (edges, bounds, the vertices for the scanline rasterizer),
-// then its Interpolants cut short after the draw's varyings (interpolants_bytes). Records are
-// laid out back to back in an arena, record_bytes() apart; never copied as a whole.
+// One triangle as binned: what the tile kernels read of its coverage (edges, bounds, the 32-bit
+// flag), then its Interpolants cut short after the draw's varyings (interpolants_bytes), then,
+// only for the scanline rasterizer (RasterAlgorithm::kScanline), its vertices. Records are laid
+// out back to back in an arena, record_bytes() apart; never copied as a whole. (The vertices,
+// which the tile kernels do not read, were first in the record: 24 bytes of every record's first
+// cache line.)
 struct TriRecord {
-  TriangleCoverage coverage;
+  EdgeFunction edge[3];  // TriangleCoverage::edge
+  PixelRect bounds;      // TriangleCoverage::bounds
   // The vertices span at most kSmallTriangleFx8 in x and y: the 32-bit coverage path applies.
   bool small = false;
 
   // The interpolants that follow the header (only var[0 .. num_varyings) exist).
   Interpolants& interp() { return *reinterpret_cast<Interpolants*>(this + 1); }
   const Interpolants& interp() const { return *reinterpret_cast<const Interpolants*>(this + 1); }
+
+  // The clockwise vertices' x[0..2] and y[0..2] (TriangleCoverage::vx, vy), after the
+  // interpolants of `num_varyings` varyings: in records made with them (record_bytes).
+  int32_t* vertices(int num_varyings) {
+    return reinterpret_cast<int32_t*>(reinterpret_cast<std::byte*>(this + 1) +
+                                      interpolants_bytes(num_varyings));
+  }
+  const int32_t* vertices(int num_varyings) const {
+    return const_cast<TriRecord*>(this)->vertices(num_varyings);
+  }
+  // The record's coverage as the rasterizers take it; precondition: made with the vertices.
+  TriangleCoverage coverage(int num_varyings) const {
+    TriangleCoverage c;
+    const int32_t* v = vertices(num_varyings);
+    for (int k = 0; k < 3; ++k) {
+      c.vx[k] = v[k];
+      c.vy[k] = v[3 + k];
+      c.edge[k] = edge[k];
+    }
+    c.bounds = bounds;
+    return c;
+  }
 };
 static_assert(sizeof(TriRecord) % alignof(Interpolants) == 0);
+static_assert(interpolants_bytes(0) % alignof(int32_t) == 0);
 
-// Bytes of one record for `num_varyings` varyings, a multiple of 8 so that records stay aligned.
-constexpr size_t record_bytes(int num_varyings) {
-  return (sizeof(TriRecord) + interpolants_bytes(num_varyings) + 7) & ~size_t(7);
+// Bytes of one record for `num_varyings` varyings, with or without the vertices, a multiple of 8
+// so that records stay aligned.
+constexpr size_t record_bytes(int num_varyings, bool with_vertices = false) {
+  return (sizeof(TriRecord) + interpolants_bytes(num_varyings) +
+          (with_vertices ? 6 * sizeof(int32_t) : 0) + 7) &
+         ~size_t(7);
 }
 
 // Append-only bytes for records, addressed by offset (so growing may move them). Its capacity is
@@ -43,8 +73,6 @@ class RecordArena {
     used_ += bytes;
     return uint32_t(offset);
   }
-  // Gives back the most recent allocation of `bytes` (a triangle that setup rejected).
-  void release_last(size_t bytes) { used_ -= bytes; }
   TriRecord* at(uint32_t offset) { return reinterpret_cast<TriRecord*>(data_.data() + offset); }
   const std::byte* data() const { return data_.data(); }
   size_t used() const { return used_; }
