@@ -45,7 +45,7 @@ namespace {
 static_assert(Framebuffer::kTileSize == kTileSize && Framebuffer::kBlockSize == kBlockSize,
               "the framebuffer stores the binning tiles contiguously");
 
-// Triangles per batch: bounds the records held at once (about 200 bytes each for 3 varyings).
+// Triangles per batch: bounds the records held at once (184 bytes each for 3 varyings).
 constexpr size_t kBatchTriangles = 32768;
 // Chunks per thread in the geometry phase, for load balance when clipping is uneven.
 constexpr int kChunksPerThread = 4;
