@@ -314,11 +314,13 @@ class BinnedDraw {
     std::atomic<size_t> next{0};
     parallel_for(workers, threads_, [&](size_t worker) {
       // Each worker takes its next tile before drawing the current one, so that the next tile's
-      // framebuffer lines are on their way while this one is drawn.
+      // framebuffer lines are on their way while this one is drawn (a pair per block drawn, the
+      // rest at the end).
+      TilePrefetch ahead;
       size_t following = next.fetch_add(1);
       for (size_t k = following; k < order.size(); k = following) {
         following = next.fetch_add(1);
-        if (following < order.size()) prefetch_tile(order[following].second);
+        ahead = following < order.size() ? tile_prefetch(order[following].second) : TilePrefetch{};
         size_t tile = order[k].second;
         auto start = state_.tile_times ? std::chrono::steady_clock::now()
                                        : std::chrono::steady_clock::time_point{};
@@ -326,10 +328,11 @@ class BinnedDraw {
         target_.framebuffer->prepare_tile(int(tile % size_t(tiles_x_)),
                                           int(tile / size_t(tiles_x_)));
         if (deferred_ && worth_deferring(tile)) {
-          resolve_and_shade_tile(tile, *cache_.scratch[worker]);
+          resolve_and_shade_tile(tile, *cache_.scratch[worker], ahead);
         } else {
-          raster_tile(tile, deferred_ ? cache_.scratch[worker].get() : nullptr);
+          raster_tile(tile, deferred_ ? cache_.scratch[worker].get() : nullptr, ahead);
         }
+        ahead.rest();
         if (state_.tile_times) {  // the `cost` debug view; one thread owns the tile
           std::chrono::duration<double> spent = std::chrono::steady_clock::now() - start;
           state_.tile_times->seconds[tile] += spent.count();
@@ -338,19 +341,17 @@ class BinnedDraw {
     });
   }
 
-  // Asks the cache for a tile's colour and depth (16 KiB each, contiguous: framebuffer.hpp), for
-  // a tile this worker draws next: the lines arrive while the current tile is drawn, instead of
+  // A tile's colour and depth (16 KiB each, contiguous: framebuffer.hpp) for the cache, for a
+  // tile this worker draws next: the lines arrive while the current tile is drawn, instead of
   // one miss at a time when the tile's clear writes them (the clear was a tenth of quad_grid's
   // frame, waiting for those lines).
-  void prefetch_tile(size_t tile) const {
+  TilePrefetch tile_prefetch(size_t tile) const {
     int x = int(tile % size_t(tiles_x_)) * kTileSize, y = int(tile / size_t(tiles_x_)) * kTileSize;
-    const auto* color = reinterpret_cast<const char*>(target_.framebuffer->color_block(x, y));
-    const auto* depth = reinterpret_cast<const char*>(target_.framebuffer->depth_block(x, y));
-    constexpr size_t kBytes = size_t(kTileSize) * kTileSize * 4;
-    for (size_t line = 0; line < kBytes; line += 64) {
-      prefetch_line(color + line);
-      prefetch_line(depth + line);
-    }
+    TilePrefetch p;
+    p.color = reinterpret_cast<const char*>(target_.framebuffer->color_block(x, y));
+    p.depth = reinterpret_cast<const char*>(target_.framebuffer->depth_block(x, y));
+    p.end = uint32_t(kTileSize) * kTileSize * 4;
+    return p;
   }
 
   // Deferred shading pays for its visibility pass only where triangles overlap: a tile whose
@@ -369,9 +370,10 @@ class BinnedDraw {
 
   // Phase 2, immediate shading: every block of every triangle goes to the fragment stage as it
   // is rasterized.
-  void raster_tile(size_t tile, DeferredScratch* scratch) {
+  void raster_tile(size_t tile, DeferredScratch* scratch, TilePrefetch& ahead) {
     TileJob job;
     job.region = tile_region(tile);
+    job.prefetch = &ahead;
     job.program = &program_;
     job.target = &target_;
     Shading shading(program_, target_);
@@ -399,10 +401,11 @@ class BinnedDraw {
 
   // Phase 2, deferred shading (tile_visibility.hpp): visibility of all the tile's triangles
   // first, in submission order, then one shading call per block and winning triangle.
-  void resolve_and_shade_tile(size_t tile, DeferredScratch& scratch) {
+  void resolve_and_shade_tile(size_t tile, DeferredScratch& scratch, TilePrefetch& ahead) {
     TileVisibility& visibility = scratch.visibility;
     TileJob job;
     job.region = tile_region(tile);
+    job.prefetch = &ahead;
     job.visibility = &visibility;
     job.less_equal = state_.depth_func == DepthFunc::kLessEqual;
     job.interps = scratch.interps.data();

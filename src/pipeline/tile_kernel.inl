@@ -281,6 +281,7 @@ struct BlockTarget {
     }
   }
   [[gnu::always_inline]] void operator()(int x, int y, uint32_t bits) {
+    if (job.prefetch != nullptr) job.prefetch->step();
     if constexpr (kMode == Mode::kImmediate) {
       if (job.batch != nullptr) {
         job.batch->add(rec.interp(), x, y, bits);
@@ -301,6 +302,7 @@ struct BlockTarget {
     static_assert(kMidBlockSize == 4 * kBlockSize && TileVisibility::kBlocksPerRow % 4 == 0);
     TileVisibility& v = *job.visibility;
     for (int j = 0; j < 4; ++j) {
+      if (job.prefetch != nullptr) job.prefetch->step();
       int row_y = y + kBlockSize * j;
       int b = v.block_index(x, row_y);
       uint32_t missing = ~uint32_t(v.touched[b >> 6] >> (b & 63)) & 0xfu;
