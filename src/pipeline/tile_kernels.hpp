@@ -37,10 +37,7 @@ struct TilePrefetch {
   }
   // The lines not yet asked for (a tile with few blocks).
   void rest() {
-    for (; next < end; next += 64) {
-      prefetch_line(color + next);
-      prefetch_line(depth + next);
-    }
+    while (next < end) step();
   }
 };
 

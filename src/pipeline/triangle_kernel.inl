@@ -128,16 +128,26 @@ template <class T, class V>
 [[gnu::always_inline]] inline void store_half(T* row, int h, const V& v) {
   std::memcpy(row + h * kH, &v, sizeof v);
 }
+// (Macros, not lambdas: GCC gives a lambda that returns a vector the default target's ABI.)
+#define SOFTRAST_HALF_DOUBLE(v) __builtin_convertvector((v), DH)
+#define SOFTRAST_HALF_FLOAT(v) __builtin_convertvector((v), FH)
+// Vertex k's float f (z, 1/w, x and y residual) for half h of the lanes, in double.
+#define SOFTRAST_FIELD(k, f) SOFTRAST_HALF_DOUBLE(half<FH>(vertex_floats[k][f], h))
 
 [[gnu::always_inline]] inline void setup_plane_lanes(const TriangleBatch& b, TriangleLanes& out) {
   // z, 1/w and the residuals of each vertex (PackedVertex's floats 2 to 5), by lane.
   alignas(64) float vertex_floats[3][4][kL];
+  // scaled_inv_w: lanes whose largest 1/w (in std::max's order) is outside [2^-20, 2^20] go to
+  // the scalar setup, which rescales it.
+  F largest;
   for (int k = 0; k < 3; ++k) {
     static_assert(sizeof(PackedVertex) == 6 * sizeof(float) && offsetof(PackedVertex, z) == 8);
     F q[4];
     load_quads(&b.window->z, out.vertex[k], 6, 4, q);
     for (int f = 0; f < 4; ++f) std::memcpy(vertex_floats[k][f], &q[f], sizeof q[f]);
+    largest = k == 0 ? q[1] : (largest < q[1] ? q[1] : largest);
   }
+  out.scalar_planes = out.ready & lane_bits(~((largest <= 0x1p20f) & (largest >= 0x1p-20f)));
   // The varyings, by lane: var_floats[k][i] for vertex k's varying i.
   alignas(64) float var_floats[3][kMaxVaryings][kL];
   for (int first = 0; first < b.num_varyings; first += 4) {
@@ -148,22 +158,7 @@ template <class T, class V>
       for (int f = 0; f < count; ++f) std::memcpy(var_floats[k][first + f], &q[f], sizeof q[f]);
     }
   }
-  out.scalar_planes = 0;
   for (int h = 0; h < 2; ++h) {
-// (Macros, not lambdas: GCC gives a lambda that returns a vector the default target's ABI.)
-#define SOFTRAST_HALF_DOUBLE(v) __builtin_convertvector((v), DH)
-#define SOFTRAST_HALF_FLOAT(v) __builtin_convertvector((v), FH)
-#define SOFTRAST_FIELD(k, f) SOFTRAST_HALF_DOUBLE(half<FH>(vertex_floats[k][f], h))
-    // scaled_inv_w: lanes whose largest 1/w (in std::max's order) is outside [2^-20, 2^20] go to
-    // the scalar setup, which rescales it.
-    FH largest = half<FH>(vertex_floats[0][1], h);
-    for (int k = 0; k < 3; ++k) {
-      const FH w = half<FH>(vertex_floats[k][1], h);
-      largest = largest < w ? w : largest;
-    }
-    const IH in_range = (largest <= 0x1p20f) & (largest >= 0x1p-20f);
-    for (int l = 0; l < kH; ++l) out.scalar_planes |= uint32_t(in_range[l] == 0) << (h * kH + l);
-
     // The snapped basis (to_pixels: times 2^-8, exact) and the exact one (the residuals).
     const DH px = DH{} + 0x1p-8;
     const IH x0 = half<IH>(out.x[0], h), y0 = half<IH>(out.y[0], h);
@@ -210,7 +205,6 @@ template <class T, class V>
       for (int c = 0; c < 3; ++c) store_half(out.var[i][c], h, SOFTRAST_HALF_FLOAT(p[c]));
     }
   }
-  out.scalar_planes &= out.ready;
 }
 #undef SOFTRAST_HALF_DOUBLE
 #undef SOFTRAST_HALF_FLOAT
