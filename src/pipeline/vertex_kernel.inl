@@ -29,8 +29,11 @@ typedef int64_t Q __attribute__((vector_size(8 * kD)));
 }
 
 // viewport.cpp's snap(): nearbyint(c * 256), NaN to 0, clamped to the fixed-point range; the
-// residual c * 256 - nearbyint(c * 256) where not clamped (else 0).
-[[gnu::always_inline]] inline Q snap(D window_coord, D& residual) {
+// residual c * 256 - nearbyint(c * 256) where not clamped (else 0). The result is an integer
+// below 2^23 in magnitude, as a double: converted straight to int32 (exact), not through int64,
+// which AVX2 has no vector conversion to (GCC converted lane by lane).
+typedef int32_t IN __attribute__((vector_size(4 * kD)));
+[[gnu::always_inline]] inline IN snap(D window_coord, D& residual) {
   D scaled = window_coord * double(kSubpixelOne);
   D fx = round_current(scaled);
   fx = (fx == fx) ? fx : D{};
@@ -38,12 +41,14 @@ typedef int64_t Q __attribute__((vector_size(8 * kD)));
   D magnitude = (fx < 0.0) ? -fx : fx;
   residual = (magnitude <= limit) ? scaled - fx : D{};
   residual = (residual == residual) ? residual : D{};
-  return __builtin_convertvector(clamp_like_std(fx, -limit, limit), Q);
+  static_assert(kMaxCoordFx8 <= (int64_t(1) << 31));
+  return __builtin_convertvector(clamp_like_std(fx, -limit, limit), IN);
 }
 
 #if SOFTRAST_DOUBLES == 8
 // A full group's positions: each vertex's x, y, z, w in one load, then two 4x4 transposes (the
-// same floats as the lane-by-lane copy, converted to double exactly).
+// same floats as the lane-by-lane copy, converted to double exactly). (The stride is at least 4
+// floats: a clip vertex's position.)
 [[gnu::always_inline]] inline void load_positions(const float* first, size_t stride, D& x, D& y,
                                                   D& z, D& w) {
   __m128 v[8];
@@ -83,6 +88,38 @@ typedef int64_t Q __attribute__((vector_size(8 * kD)));
                    _mm512_permutex2var_epi64(a, _mm512_setr_epi64(13, 0, 6, 14, 0, 7, 15, 0), b),
                    0x92, _mm512_setr_epi64(0, 5, 0, 0, 6, 0, 0, 7), c));
 }
+#elif SOFTRAST_DOUBLES == 4
+// The same for AVX2's groups of 4: one 4x4 transpose.
+[[gnu::always_inline]] inline void load_positions(const float* first, size_t stride, D& x, D& y,
+                                                  D& z, D& w) {
+  __m128 v[4];
+  for (int l = 0; l < 4; ++l) v[l] = _mm_loadu_ps(first + size_t(l) * stride);
+  _MM_TRANSPOSE4_PS(v[0], v[1], v[2], v[3]);
+  x = reinterpret_cast<D>(_mm256_cvtps_pd(v[0]));
+  y = reinterpret_cast<D>(_mm256_cvtps_pd(v[1]));
+  z = reinterpret_cast<D>(_mm256_cvtps_pd(v[2]));
+  w = reinterpret_cast<D>(_mm256_cvtps_pd(v[3]));
+}
+
+// 4 x 24 bytes as three 32-byte stores: the fields paired into 64-bit (x, y), (z, inv_w) and
+// (x_residual, y_residual) lanes, then those interleaved record by record.
+[[gnu::always_inline]] inline void store_records(PackedVertex* out, __m128i x, __m128i y, __m128 z,
+                                                 __m128 inv_w, __m128 rx, __m128 ry) {
+  static_assert(sizeof(PackedVertex) == 24);
+  const __m128i xy01 = _mm_unpacklo_epi32(x, y), xy23 = _mm_unpackhi_epi32(x, y);
+  const __m128i zw01 = _mm_castps_si128(_mm_unpacklo_ps(z, inv_w));
+  const __m128i zw23 = _mm_castps_si128(_mm_unpackhi_ps(z, inv_w));
+  const __m128i rr01 = _mm_castps_si128(_mm_unpacklo_ps(rx, ry));
+  const __m128i rr23 = _mm_castps_si128(_mm_unpackhi_ps(rx, ry));
+  // Records 0 to 3 in 64-bit pieces: xy0 zw0 rr0 xy1 | zw1 rr1 xy2 zw2 | rr2 xy3 zw3 rr3.
+  auto* dst = reinterpret_cast<__m256i*>(out);
+  _mm256_storeu_si256(
+      dst, _mm256_set_m128i(_mm_blend_epi32(rr01, xy01, 0xc), _mm_unpacklo_epi64(xy01, zw01)));
+  _mm256_storeu_si256(
+      dst + 1, _mm256_set_m128i(_mm_unpacklo_epi64(xy23, zw23), _mm_unpackhi_epi64(zw01, rr01)));
+  _mm256_storeu_si256(
+      dst + 2, _mm256_set_m128i(_mm_unpackhi_epi64(zw23, rr23), _mm_blend_epi32(rr23, xy23, 0xc)));
+}
 #endif
 
 void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
@@ -90,7 +127,7 @@ void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
   for (size_t i = begin; i < end; i += kD) {
     size_t lanes = std::min<size_t>(kD, end - i);
     D x, y, z, w;
-#if SOFTRAST_DOUBLES == 8
+#if SOFTRAST_DOUBLES >= 4
     if (lanes == kD) {
       load_positions(b.data + i * size_t(b.stride), size_t(b.stride), x, y, z, w);
     } else
@@ -112,13 +149,11 @@ void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
     D inv_w = 1.0 / w;
     D x_ndc = x * inv_w, y_ndc = y * inv_w, z_ndc = z * inv_w;
     D rx, ry;
-    Q wx = snap((x_ndc + 1.0) * 0.5 * width, rx);
-    Q wy = snap((1.0 - y_ndc) * 0.5 * height, ry);
+    IN xi = snap((x_ndc + 1.0) * 0.5 * width, rx);
+    IN yi = snap((1.0 - y_ndc) * 0.5 * height, ry);
     D wz = clamp_like_std((z_ndc + 1.0) * 0.5, 0.0, 1.0);
     // The six fields converted in vectors, then written vertex by vertex.
     typedef float FN __attribute__((vector_size(4 * kD)));
-    typedef int32_t IN __attribute__((vector_size(4 * kD)));
-    IN xi = __builtin_convertvector(wx, IN), yi = __builtin_convertvector(wy, IN);
     const IN outside = __builtin_convertvector(code != 0, IN);  // PackedVertex: kOutsideVolume
     xi = outside ? IN{} + kOutsideVolume : xi;
     FN zf = __builtin_convertvector(wz, FN), wf = __builtin_convertvector(inv_w, FN);
@@ -133,6 +168,14 @@ void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
       store_records(b.window + i, reinterpret_cast<__m256i>(xi), reinterpret_cast<__m256i>(yi),
                     reinterpret_cast<__m256>(zf), reinterpret_cast<__m256>(wf),
                     reinterpret_cast<__m256>(rxf), reinterpret_cast<__m256>(ryf));
+      continue;
+    }
+#elif SOFTRAST_DOUBLES == 4
+    if (lanes == kD) {
+      for (int l = 0; l < kD; ++l) b.codes[i + size_t(l)] = uint8_t(code[l]);
+      store_records(b.window + i, reinterpret_cast<__m128i>(xi), reinterpret_cast<__m128i>(yi),
+                    reinterpret_cast<__m128>(zf), reinterpret_cast<__m128>(wf),
+                    reinterpret_cast<__m128>(rxf), reinterpret_cast<__m128>(ryf));
       continue;
     }
 #endif
