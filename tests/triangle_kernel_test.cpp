@@ -28,7 +28,8 @@ namespace {
 // Clip-space vertices (x, y, z, w, kKernelVaryings varyings): mostly inside the view, and some of
 // each kind the front end treats apart: beyond the guard band, behind the eye, NaN and Inf,
 // exactly on planes, snapped onto the same point (zero area), triangles larger than the 32-bit
-// path's, and 1/w outside [2^-20, 2^20] (planes rescaled by the scalar setup).
+// path's, 1/w outside [2^-20, 2^20] (planes rescaled by the scalar setup), and edges through
+// pixel centres.
 constexpr int kKernelVaryings = 6;  // one group of four and a partial one
 std::vector<float> kernel_vertices(int count, unsigned seed) {
   std::mt19937 rng(seed);
@@ -66,6 +67,22 @@ std::vector<float> kernel_vertices(int count, unsigned seed) {
       case 8:  // the same point in tiny or huge units: 1/w above 2^20 or below 2^-20
         for (int k = 0; k < 4; ++k) p[k] *= i % 29 == 7 ? 1e-7f : 4e6f;
         break;
+      case 9:
+      case 10:
+      case 11:
+      case 12: {
+        // On columns of pixel centres of the 64-pixel-wide image (w = 1, so exactly): 9 on one,
+        // 10 and 11 on the next, 12 on the one after. Their triangles' vertical edges pass
+        // through samples, on the left (covered) or the right (not): the fill rule decides, in
+        // the tiny-triangle test too.
+        const int k = i % 29;
+        const int column = 20 + (i / 29) % 7 + (k == 9 ? 0 : k == 12 ? 2 : 1);
+        p[0] = float(2 * column + 1) / 64.0f - 1.0f;
+        p[1] = 0.3f * unit(rng);
+        p[2] = unit(rng);
+        p[3] = 1.0f;
+        break;
+      }
       default:
         break;
     }
@@ -84,6 +101,23 @@ bool covers_a_pixel(const detail::TriangleCoverage& c) {
         inside = inside && e.at(detail::sample_fx8(x), detail::sample_fx8(y)) >= 0;
       }
       if (inside) return true;
+    }
+  }
+  return false;
+}
+
+// Whether a sample of the coverage's bounds lies exactly on an edge's line (E = 0 before the fill
+// rule's bias, E = 0 or -1 after it), inside the other two edges.
+bool sample_on_an_edge(const detail::TriangleCoverage& c) {
+  for (int y = c.bounds.y0; y < c.bounds.y1; ++y) {
+    for (int x = c.bounds.x0; x < c.bounds.x1; ++x) {
+      int on = 0, inside = 0;
+      for (const detail::EdgeFunction& e : c.edge) {
+        int64_t v = e.at(detail::sample_fx8(x), detail::sample_fx8(y));
+        on += v == 0 || v == -1;
+        inside += v >= 0;
+      }
+      if (on == 1 && inside >= 2) return true;
     }
   }
   return false;
@@ -108,7 +142,7 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
     }
   }
   int checked_ready = 0, checked_scalar = 0, checked_none = 0, checked_dropped = 0,
-      checked_rescaled = 0;
+      checked_rescaled = 0, checked_on_edge = 0;
   for (SimdLevel level : {SimdLevel::kAvx2, SimdLevel::kAvx512}) {
     if (cpu_simd_level() < level) continue;
     const detail::TriangleKernel kernel = detail::triangle_kernel(level);
@@ -173,6 +207,10 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
                   ASSERT_FALSE(ready);
                   ++checked_none;
                   continue;
+                }
+                if (want.bounds.x1 - want.bounds.x0 <= 4 && want.bounds.y1 - want.bounds.y0 <= 4 &&
+                    sample_on_an_edge(want)) {
+                  ++checked_on_edge;  // kept or dropped below by the fill rule's decision
                 }
                 if (!ready) {
                   // Dropped by the kernel: bounds of at most 4x4 pixels, no sample covered.
@@ -258,6 +296,7 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
   EXPECT_GT(checked_none, 10000);
   EXPECT_GT(checked_dropped, 1000);
   EXPECT_GT(checked_rescaled, 100);
+  EXPECT_GT(checked_on_edge, 100);
 }
 
 // Flat-coloured triangles of both facings, some crossing the near plane and the image border,

@@ -63,8 +63,6 @@ typedef float F __attribute__((vector_size(4 * kL)));
 // An integer-valued double below 2^51 in magnitude to int64, exactly: added to 1.5 * 2^52 its
 // integer is the low bits of the sum's mantissa.
 #define SOFTRAST_EXACT_INT64(v) (Q((v) + (D{} + 0x1.8p52)) - Q(D{} + 0x1.8p52))
-// A 64-bit lane mask (0 or -1) as a 32-bit one.
-#define SOFTRAST_NARROW(mask) __builtin_convertvector((mask), I)
 
 // Four consecutive floats of every lane, from base + index[l] * stride (the first `count` of
 // them; the others 0, not read), as four vectors: out[f] lane l = base[index[l] * stride + f].
@@ -242,7 +240,20 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
   // signed_area_fx16, then is_culled (zero area is never kept).
   const D area = SOFTRAST_TO_DOUBLE(x1 - x0) * SOFTRAST_TO_DOUBLE(y2 - y0) -
                  SOFTRAST_TO_DOUBLE(x2 - x0) * SOFTRAST_TO_DOUBLE(y1 - y0);
-  const I negative = SOFTRAST_NARROW(area < 0.0), nonzero = SOFTRAST_NARROW(area != 0.0);
+  // Its sign, half the lanes at a time (a compare of a vector of doubles two registers wide is
+  // compiled lane by lane).
+  I negative, nonzero;
+  {
+    IH half_negative[2], half_nonzero[2];
+    for (int h = 0; h < 2; ++h) {
+      DH part;
+      std::memcpy(&part, reinterpret_cast<const char*>(&area) + h * sizeof(DH), sizeof part);
+      half_negative[h] = __builtin_convertvector(part < 0.0, IH);
+      half_nonzero[h] = __builtin_convertvector(part != 0.0, IH);
+    }
+    std::memcpy(&negative, half_negative, sizeof negative);
+    std::memcpy(&nonzero, half_nonzero, sizeof nonzero);
+  }
   const I front = nonzero & (b.front_face == FrontFace::kCounterClockwise ? negative : ~negative);
   I culled = I{};
   if (b.cull == CullMode::kBack) culled = ~front;
@@ -280,15 +291,18 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
   // c = dy xi - dx yi, one less unless the edge is top or left (is_top_left).
   I edge_a[3], edge_b[3];
   Q edge_c[3];
+  D edge_c_double[3];  // the same integers as doubles (exact), for the test below
   for (int k = 0; k < 3; ++k) {
     const int j = (k + 1) % 3;
     const I dx = vx[j] - vx[k], dy = vy[j] - vy[k];
     edge_a[k] = -dy;
     edge_b[k] = dx;
     const I top_left = (dy < 0) | ((dy == 0) & (dx > 0));
-    edge_c[k] = SOFTRAST_EXACT_INT64(SOFTRAST_TO_DOUBLE(dy) * SOFTRAST_TO_DOUBLE(vx[k]) -
-                                     SOFTRAST_TO_DOUBLE(dx) * SOFTRAST_TO_DOUBLE(vy[k])) +
-                __builtin_convertvector(~top_left, Q);  // -1 where not top-left
+    const D c = SOFTRAST_TO_DOUBLE(dy) * SOFTRAST_TO_DOUBLE(vx[k]) -
+                SOFTRAST_TO_DOUBLE(dx) * SOFTRAST_TO_DOUBLE(vy[k]);
+    edge_c[k] =
+        SOFTRAST_EXACT_INT64(c) + __builtin_convertvector(~top_left, Q);  // -1: not top-left
+    edge_c_double[k] = c + SOFTRAST_TO_DOUBLE(~top_left);
   }
 
   // A triangle whose bounds are at most 4x4 pixels and whose edges pass no sample inside them
@@ -307,7 +321,7 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
     I e[3], step_x[3], step_y[3];
     for (int k = 0; k < 3; ++k) {
       const D at = SOFTRAST_TO_DOUBLE(edge_a[k]) * sx + SOFTRAST_TO_DOUBLE(edge_b[k]) * sy +
-                   __builtin_convertvector(edge_c[k], D);
+                   edge_c_double[k];
       e[k] = speck ? __builtin_convertvector(at, I) : I{};  // other lanes: unused, kept finite
       step_x[k] = (speck & edge_a[k]) * kSubpixelOne;
       step_y[k] = (speck & edge_b[k]) * kSubpixelOne;
@@ -344,4 +358,3 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
 
 #undef SOFTRAST_TO_DOUBLE
 #undef SOFTRAST_EXACT_INT64
-#undef SOFTRAST_NARROW
