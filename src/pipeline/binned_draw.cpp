@@ -264,8 +264,17 @@ class BinnedDraw {
   }
 
   void bin(Chunk& chunk, const PixelRect& bounds, uint32_t offset) {
-    int tx0 = bounds.x0 / kTileSize, tx1 = (bounds.x1 - 1) / kTileSize;
-    int ty0 = bounds.y0 / kTileSize, ty1 = (bounds.y1 - 1) / kTileSize;
+    // The bounds lie inside the scissor: no coordinate is negative.
+    int tx0 = int(unsigned(bounds.x0) / kTileSize), tx1 = int(unsigned(bounds.x1 - 1) / kTileSize);
+    int ty0 = int(unsigned(bounds.y0) / kTileSize), ty1 = int(unsigned(bounds.y1 - 1) / kTileSize);
+    if (tx0 == tx1 && ty0 == ty1) {  // the usual triangle of a dense mesh: one tile, all of it
+      size_t tile = size_t(ty0) * tiles_x_ + tx0;
+      chunk.bins[tile].push_back(offset);
+      if (!chunk.box_area.empty()) {
+        chunk.box_area[tile] += int64_t(bounds.x1 - bounds.x0) * (bounds.y1 - bounds.y0);
+      }
+      return;
+    }
     for (int ty = ty0; ty <= ty1; ++ty) {
       for (int tx = tx0; tx <= tx1; ++tx) chunk.bins[size_t(ty) * tiles_x_ + tx].push_back(offset);
     }
