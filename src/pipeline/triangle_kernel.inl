@@ -244,15 +244,14 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
   // compiled lane by lane).
   I negative, nonzero;
   {
-    IH half_negative[2], half_nonzero[2];
+    alignas(64) int32_t negative_lanes[kL], nonzero_lanes[kL];
     for (int h = 0; h < 2; ++h) {
-      DH part;
-      std::memcpy(&part, reinterpret_cast<const char*>(&area) + h * sizeof(DH), sizeof part);
-      half_negative[h] = __builtin_convertvector(part < 0.0, IH);
-      half_nonzero[h] = __builtin_convertvector(part != 0.0, IH);
+      const DH part = half<DH>(reinterpret_cast<const double*>(&area), h);
+      store_half(negative_lanes, h, __builtin_convertvector(part < 0.0, IH));
+      store_half(nonzero_lanes, h, __builtin_convertvector(part != 0.0, IH));
     }
-    std::memcpy(&negative, half_negative, sizeof negative);
-    std::memcpy(&nonzero, half_nonzero, sizeof nonzero);
+    std::memcpy(&negative, negative_lanes, sizeof negative);
+    std::memcpy(&nonzero, nonzero_lanes, sizeof nonzero);
   }
   const I front = nonzero & (b.front_face == FrontFace::kCounterClockwise ? negative : ~negative);
   I culled = I{};

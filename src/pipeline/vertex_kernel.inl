@@ -152,7 +152,8 @@ void transform_vertices(const VertexBatch& b, size_t begin, size_t end) {
     IN xi = snap((x_ndc + 1.0) * 0.5 * width, rx);
     IN yi = snap((1.0 - y_ndc) * 0.5 * height, ry);
     D wz = clamp_like_std((z_ndc + 1.0) * 0.5, 0.0, 1.0);
-    // The six fields converted in vectors, then written vertex by vertex.
+    // The six fields converted in vectors, then written: a full group by vector stores at AVX2 and
+    // AVX-512, vertex by vertex otherwise.
     typedef float FN __attribute__((vector_size(4 * kD)));
     const IN outside = __builtin_convertvector(code != 0, IN);  // PackedVertex: kOutsideVolume
     xi = outside ? IN{} + kOutsideVolume : xi;
