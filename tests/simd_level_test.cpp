@@ -335,6 +335,73 @@ TEST(SimdFma, NormalizeEqualsGlmAtEveryLevel) {
   }
 }
 
+// A depth plane at one level (detail::eval_plane on 16 lanes) against the scalar eval_plane, over
+// planes and pixel offsets: how many lanes differ. +0 and -0 count as equal (the vector form adds
+// a0 to +0 first; both compare equal in every depth test), as does NaN against NaN.
+struct PlaneCase {
+  detail::DepthPlane plane;
+  float dx[simd::kLanes], dy[simd::kLanes];
+};
+template <int N>
+int depth_plane_mismatches(const std::vector<PlaneCase>& cases);
+template <int N>
+int depth_plane_mismatches_impl(const std::vector<PlaneCase>& cases) {
+  int mismatches = 0;
+  for (const PlaneCase& c : cases) {
+    float z[simd::kLanes];
+    detail::eval_plane<N>(c.plane, simd::Float<N>::load(c.dx), simd::Float<N>::load(c.dy)).store(z);
+    for (int i = 0; i < simd::kLanes; ++i) {
+      float want = detail::eval_plane(c.plane, c.dx[i], c.dy[i]);
+      mismatches += !(z[i] == want || (std::isnan(z[i]) && std::isnan(want)));
+    }
+  }
+  return mismatches;
+}
+template <>
+int depth_plane_mismatches<4>(const std::vector<PlaneCase>& cases) {
+  return depth_plane_mismatches_impl<4>(cases);
+}
+template <>
+[[gnu::target("avx2,fma")]] int depth_plane_mismatches<8>(const std::vector<PlaneCase>& cases) {
+  return depth_plane_mismatches_impl<8>(cases);
+}
+template <>
+[[gnu::target("avx512f,avx512bw,avx512dq,avx512vl")]] int depth_plane_mismatches<16>(
+    const std::vector<PlaneCase>& cases) {
+  return depth_plane_mismatches_impl<16>(cases);
+}
+
+// The fragment stage's depth is the scalar plane's, bit for bit, at every level: the tile kernels'
+// depth resolve computes the same double sum, and deferred shading is exact only if the two agree.
+// Half the planes nearly cancel at one pixel, so that a change of the operations' order (a
+// reassociated sum, a fused multiply-add, a float product) changes the rounded depth there (a
+// reassociated sum changes about half of those lanes).
+TEST(SimdDepthPlane, EqualsTheScalarPlaneBitForBitAtEveryLevel) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> offset(-40.0f, 40.0f);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<PlaneCase> cases(2048);
+  for (size_t k = 0; k < cases.size(); ++k) {
+    PlaneCase& c = cases[k];
+    for (int i = 0; i < simd::kLanes; ++i) c.dx[i] = offset(rng), c.dy[i] = offset(rng);
+    c.plane.dadx = unit(rng) * 1.0e-2;
+    c.plane.dady = unit(rng) * 1.0e-2;
+    c.plane.a0 = 0.5 + unit(rng) * 0.5;
+    if (k % 2 == 1) {  // about 1e-12 at lane 0: there a double's rounding shows in the float
+      c.plane.a0 =
+          -(c.plane.dadx * double(c.dx[0]) + c.plane.dady * double(c.dy[0])) + unit(rng) * 1.0e-12;
+    }
+  }
+  cases[0].plane = {-0.0, 0.0, -0.0};  // zeros of both signs
+  EXPECT_EQ(depth_plane_mismatches<4>(cases), 0);
+  if (cpu_simd_level() >= SimdLevel::kAvx2) {
+    EXPECT_EQ(depth_plane_mismatches<8>(cases), 0);
+  }
+  if (cpu_simd_level() >= SimdLevel::kAvx512) {
+    EXPECT_EQ(depth_plane_mismatches<16>(cases), 0);
+  }
+}
+
 TEST(SimdSampler, MatchesScalarSamplingBitForBitAtEveryLevel) {
   GatherModeGuard guard;
   std::mt19937 rng(7);

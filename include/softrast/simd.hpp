@@ -80,6 +80,16 @@ SOFTRAST_AVX512 void blend(const I16& mask, const F16& a, const F16& b, F16& r);
 SOFTRAST_AVX512 void blend(const I16& mask, const I16& a, const I16& b, I16& r);
 SOFTRAST_AVX512 void broadcast(float s, F16& r);
 SOFTRAST_AVX512 void broadcast(int32_t s, I16& r);
+// AVX2's broadcasts, one VBROADCASTSS or VPBROADCASTD (the shuffle of lane 0 below is a move into
+// a zeroed register, a move to clear the upper lanes again and then the broadcast).
+using F8 = float __attribute__((vector_size(32)));
+using I8 = int32_t __attribute__((vector_size(32)));
+[[gnu::target("avx")]] inline void broadcast(float s, F8& r) {
+  r = F8(_mm256_set1_ps(s));
+}
+[[gnu::target("avx2")]] inline void broadcast(int32_t s, I8& r) {
+  r = I8(_mm256_set1_epi32(s));
+}
 }  // namespace isa
 
 template <int N>
@@ -92,13 +102,15 @@ struct Float {
   Float() = default;
   // Broadcast; implicit so that 2.0f * x reads naturally. (Written as a shuffle of lane 0:
   // GCC 12 builds `V{} + s` lane by lane once it has been inlined into a wider target; at 16
-  // lanes the shuffle became two broadcasts, so there it is the intrinsic.)
+  // lanes the shuffle became two broadcasts and at 8 three instructions, so there it is the
+  // intrinsic.)
   SOFTRAST_SIMD_INLINE Float(float s) {
 #if defined(__clang__)  // no __builtin_shuffle; clang broadcasts a scalar added to a vector
     for (int k = 0; k < kParts; ++k) p[k] = V{} + s;
 #else
-    if constexpr (N == 16) {
+    if constexpr (N == 16 || N == 8) {
       isa::broadcast(s, p[0]);  // one VBROADCASTSS
+      for (int k = 1; k < kParts; ++k) p[k] = p[0];
     } else {
       V t = {};
       t[0] = s;
@@ -177,8 +189,9 @@ struct Int {
 #if defined(__clang__)
     for (int k = 0; k < kParts; ++k) p[k] = V{} + s;
 #else
-    if constexpr (N == 16) {
+    if constexpr (N == 16 || N == 8) {
       isa::broadcast(s, p[0]);
+      for (int k = 1; k < kParts; ++k) p[k] = p[0];
     } else {
       V t = {};
       t[0] = s;

@@ -115,8 +115,8 @@ SOFTRAST_SIMD_INLINE simd::Float<N> eval_plane(const Plane& p, const simd::Float
   // The scalar eval_plane's operation order, so that both give the same bits.
   return simd::Float<N>(p.a0) + simd::Float<N>(p.dadx) * dx + simd::Float<N>(p.dady) * dy;
 }
-// Half a register's floats, and as many doubles (one register), at SSE and AVX2; split and join
-// move between a register (Fn) and its two halves.
+// Half a register's floats, and as many doubles (one register), at SSE; split and join move
+// between a register (Fn) and its two halves.
 template <std::size_t kBytes>
 struct HalfLanes;
 template <>
@@ -132,31 +132,37 @@ struct HalfLanes<16> {
     out = __builtin_shufflevector(low, high, 0, 1, 2, 3);
   }
 };
-template <>
-struct HalfLanes<32> {
-  typedef float Fn __attribute__((vector_size(32)));
-  typedef float F __attribute__((vector_size(16)));
-  typedef double D __attribute__((vector_size(32)));
-  SOFTRAST_SIMD_INLINE static void split(const Fn& x, F& low, F& high) {
-    low = __builtin_shufflevector(x, x, 0, 1, 2, 3);
-    high = __builtin_shufflevector(x, x, 4, 5, 6, 7);
-  }
-  SOFTRAST_SIMD_INLINE static void join(const F& low, const F& high, Fn& out) {
-    out = __builtin_shufflevector(low, high, 0, 1, 2, 3, 4, 5, 6, 7);
-  }
-};
 // (A named function, not a lambda: see pack_channel.)
 template <class H, class DH>
 SOFTRAST_SIMD_INLINE void half_plane(const DepthPlane& p, const H& x, const H& y, H& out) {
   const DH xd = __builtin_convertvector(x, DH), yd = __builtin_convertvector(y, DH);
   out = __builtin_convertvector(((DH{} + p.a0) + (DH{} + p.dadx) * xd) + (DH{} + p.dady) * yd, H);
 }
+// AVX2's eight lanes at once: each half converted by one VCVTPS2PD (GCC 12 made the conversion of
+// a half above two conversions of two lanes, a move and an insert) and back by one VCVTPD2PS.
+// The same operations in the same order as half_plane, so the same bits.
+[[gnu::target("avx")]] inline __m128 plane4(const __m256d& a0, const __m256d& dadx,
+                                            const __m256d& dady, __m128 x, __m128 y) {
+  const __m256d xd = _mm256_cvtps_pd(x), yd = _mm256_cvtps_pd(y);
+  return _mm256_cvtpd_ps(
+      _mm256_add_pd(_mm256_add_pd(a0, _mm256_mul_pd(dadx, xd)), _mm256_mul_pd(dady, yd)));
+}
+[[gnu::target("avx")]] inline void plane8(const DepthPlane& p, const simd::Native<8>::F& x,
+                                          const simd::Native<8>::F& y, simd::Native<8>::F& out) {
+  const __m256d a0 = _mm256_set1_pd(0.0 + p.a0), dadx = _mm256_set1_pd(0.0 + p.dadx),
+                dady = _mm256_set1_pd(0.0 + p.dady);
+  const __m256 xv = __m256(x), yv = __m256(y);
+  const __m128 low = plane4(a0, dadx, dady, _mm256_castps256_ps128(xv), _mm256_castps256_ps128(yv));
+  const __m128 high =
+      plane4(a0, dadx, dady, _mm256_extractf128_ps(xv, 1), _mm256_extractf128_ps(yv, 1));
+  out = simd::Native<8>::F(_mm256_insertf128_ps(_mm256_castps128_ps256(low), high, 1));
+}
 // Depth: the plane in double, rounded to float once, as the scalar eval_plane and the tile
-// kernels' depth resolve compute it (the same operations, so the same bits). At SSE and AVX2 each
-// part's lanes go in two halves, each converted to one register of doubles: a vector of doubles
-// twice the register's width, broadcast from a scalar, went through the stack lane by lane there
-// (scalar stores, then wide loads that could not take them from the store buffer: a third of the
-// AVX2 texture shader's samples).
+// kernels' depth resolve compute it (the same operations, so the same bits). At SSE (and AVX2, by
+// plane8) each part's lanes go in two halves, each converted to one register of doubles: a vector
+// of doubles twice the register's width, broadcast from a scalar, went through the stack lane by
+// lane there (scalar stores, then wide loads that could not take them from the store buffer: a
+// third of the AVX2 texture shader's samples).
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Float<N> eval_plane(const DepthPlane& p, const simd::Float<N>& dx,
                                                const simd::Float<N>& dy) {
@@ -171,6 +177,8 @@ SOFTRAST_SIMD_INLINE simd::Float<N> eval_plane(const DepthPlane& p, const simd::
       D x = __builtin_convertvector(dx.p[k], D), y = __builtin_convertvector(dy.p[k], D);
       z.p[k] = __builtin_convertvector((a0 + dadx * x) + dady * y, Fn);
     }
+  } else if constexpr (kHalf == 4) {
+    for (int k = 0; k < simd::Float<N>::kParts; ++k) plane8(p, dx.p[k], dy.p[k], z.p[k]);
   } else {
     using Half = HalfLanes<sizeof(Fn)>;
     for (int k = 0; k < simd::Float<N>::kParts; ++k) {
