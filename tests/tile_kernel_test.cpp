@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <limits>
 #include <map>
@@ -14,6 +15,8 @@
 #include "pipeline/tile_kernels.hpp"
 #include "raster/raster.hpp"
 #include "softrast/shader.hpp"
+#include "softrast/simd_level.hpp"
+#include "test_util.hpp"
 
 namespace softrast {
 namespace {
@@ -174,6 +177,74 @@ TEST(TileKernel, ResolveComputesTheFragmentStagesDepth) {
           << simd_level_name(SimdLevel(level)) << " case " << i;
     }
   }
+}
+
+// Counts the pixels it shades (the live lanes of its calls), from any thread.
+struct LaneCounter {
+  static constexpr int kVaryings = 0;
+  const glm::vec4* positions = nullptr;
+  mutable std::atomic<int64_t> shaded{0};
+  glm::vec4 vertex(uint32_t index, float*) const { return positions[index]; }
+  template <int N>
+  void shade(Fragments<N>& f) const {
+    shaded += __builtin_popcount(simd::bits(f.live));
+    f.color = {simd::Float<N>(1.0f), simd::Float<N>(1.0f), simd::Float<N>(1.0f),
+               simd::Float<N>(1.0f)};
+  }
+};
+
+// A framebuffer stores the blocks cut by the image's right and bottom edges whole, but only the
+// image's pixels are shaded: a mesh that covers more than the image shades each pixel once (the
+// fill rule gives a pixel to one triangle), for images whose size is not a multiple of 4 and one
+// that is, with small triangles (each block's coverage directly) and large ones (16x16 areas
+// classified), immediate (additive) and deferrable (opaque, depth less), at every level, with 1
+// and 2 threads.
+TEST(TileKernel, ShadesOnlyTheImagesPixels) {
+  SimdLevel cap = simd_level();
+  for (auto [width, height] : {std::pair{61, 37}, std::pair{130, 67}, std::pair{64, 48}}) {
+    for (int cells : {1, 3, 24}) {
+      std::vector<glm::vec4> clip;
+      std::vector<uint32_t> indices;
+      for (int j = 0; j <= cells; ++j) {
+        for (int i = 0; i <= cells; ++i) {
+          clip.push_back({-1.25f + 2.5f * float(i) / float(cells),
+                          -1.25f + 2.5f * float(j) / float(cells), 0.5f, 1.0f});
+        }
+      }
+      for (int j = 0; j < cells; ++j) {
+        for (int i = 0; i < cells; ++i) {
+          uint32_t a = uint32_t(j * (cells + 1) + i), b = a + 1, c = a + uint32_t(cells + 1),
+                   d = c + 1;
+          indices.insert(indices.end(), {a, b, d, a, d, c});
+        }
+      }
+      for (bool opaque : {false, true}) {
+        RenderState state = test::counting_state();
+        if (opaque) {
+          state.blend = BlendMode::kOpaque;
+          state.depth_test = true;
+          state.depth_func = DepthFunc::kLess;
+          state.depth_write = true;
+        }
+        for (int level = 0; level <= int(cap); ++level) {
+          set_simd_level(SimdLevel(level));
+          for (int threads : {1, 2}) {
+            state.threads = threads;
+            Framebuffer fb(width, height);
+            fb.clear({0.0f, 0.0f, 0.0f, 0.0f});
+            LaneCounter shader;
+            shader.positions = clip.data();
+            draw(fb, state, shader, indices, uint32_t(clip.size()));
+            EXPECT_EQ(shader.shaded.load(), int64_t(width) * height)
+                << width << "x" << height << ", " << cells << " cells, "
+                << (opaque ? "opaque" : "additive") << ", " << simd_level_name(SimdLevel(level))
+                << ", threads " << threads;
+          }
+        }
+      }
+    }
+  }
+  set_simd_level(cap);
 }
 
 }  // namespace

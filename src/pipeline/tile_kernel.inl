@@ -363,17 +363,31 @@ template <Mode kMode, class V, class T>
   EdgeOffsets<V> offsets;
   make_offsets<V, T>(t, offsets);
   int bx0 = area.x0 & ~(kBlockSize - 1), by0 = area.y0 & ~(kBlockSize - 1);
-  auto partial_block = [&](int x, int y) {
-    int64_t e[3];
-    grid.at(x, y, e);
-    uint32_t bits = coverage_bits<V, T>(e, offsets) & region_bits(job.region, x, y);
+  // Whether every block of the tile's region is whole (the region's right and bottom edges on
+  // block boundaries, as they are but for images whose size is not a multiple of 4): then no
+  // block needs region_bits. A local, so that the loops below keep it in a register.
+  const bool whole_blocks = ((job.region.x1 | job.region.y1) & (kBlockSize - 1)) == 0;
+  auto region = [&](int x, int y) {
+    return whole_blocks ? 0xffffu : region_bits(job.region, x, y);
+  };
+  // `e`: the edge values at the block's first sample.
+  auto partial_block = [&](int x, int y, const int64_t e[3]) {
+    uint32_t bits = coverage_bits<V, T>(e, offsets) & region(x, y);
     if (bits != 0) emit(x, y, bits);
   };
   // Small areas (at most 16x16 pixels of blocks, the usual triangle of a dense mesh): every
-  // block's coverage directly, no classification.
+  // block's coverage directly, no classification; the edge values stepped from block to block
+  // (the exact int64 sums grid.at gives).
   if (area.x1 - bx0 <= kMidBlockSize && area.y1 - by0 <= kMidBlockSize) {
+    int64_t row[3];
+    grid.at(bx0, by0, row);
     for (int y = by0; y < area.y1; y += kBlockSize) {
-      for (int x = bx0; x < area.x1; x += kBlockSize) partial_block(x, y);
+      int64_t e[3] = {row[0], row[1], row[2]};
+      for (int x = bx0; x < area.x1; x += kBlockSize) {
+        partial_block(x, y, e);
+        for (int k = 0; k < 3; ++k) e[k] += grid.step_x[k] * kBlockSize;
+      }
+      for (int k = 0; k < 3; ++k) row[k] += grid.step_y[k] * kBlockSize;
     }
     return;
   }
@@ -406,9 +420,9 @@ template <Mode kMode, class V, class T>
             sub = classify(e, small);
           }
           if (sub == Test::kInside) {
-            emit(x, y, region_bits(job.region, x, y));
+            emit(x, y, region(x, y));
           } else if (sub == Test::kPartial) {
-            partial_block(x, y);
+            partial_block(x, y, e);  // (only a partial area has partial blocks: e is at x, y)
           }
         }
       }
