@@ -115,14 +115,7 @@ class BinnedDraw {
     const PixelRect& s = geometry.scissor();
     tiles_x_ = (s.x1 + kTileSize - 1) / kTileSize;
     tiles_y_ = (s.y1 + kTileSize - 1) / kTileSize;
-    // The cache keeps the most chunks any draw used (one thread needs one), so alternating
-    // thread counts does not free and reallocate arenas.
     num_chunks_ = threads == 1 ? 1 : size_t(threads) * kChunksPerThread;
-    if (cache_.chunks.size() < num_chunks_) cache_.chunks.resize(num_chunks_);
-    for (size_t c = 0; c < num_chunks_; ++c) {
-      cache_.chunks[c].bins.resize(size_t(tiles_x_) * size_t(tiles_y_));
-      cache_.chunks[c].box_area.resize(deferred_ ? size_t(tiles_x_) * size_t(tiles_y_) : 0);
-    }
     if (TileTimes* t = state.tile_times; t && (t->tiles_x != tiles_x_ || t->tiles_y != tiles_y_)) {
       t->tiles_x = tiles_x_;
       t->tiles_y = tiles_y_;
@@ -133,19 +126,52 @@ class BinnedDraw {
   void draw(const uint32_t* indices, size_t index_count) {
     cache_.vertices.transform(geometry_, threads_);
     size_t triangles = index_count / 3;
-    for (size_t first = 0; first < triangles; first += kBatchTriangles) {
-      size_t count = std::min(kBatchTriangles, triangles - first);
-      size_t per_chunk = (count + num_chunks_ - 1) / num_chunks_;
-      parallel_for(num_chunks_, threads_, [&](size_t c) {
-        size_t begin = std::min(first + count, first + c * per_chunk);
-        size_t end = std::min(first + count, begin + per_chunk);
-        setup_chunk(cache_.chunks[c], indices, begin, end);
-      });
-      raster_tiles();
+    size_t batches = (triangles + kBatchTriangles - 1) / kBatchTriangles;
+    // With several threads and batches, batch b's setup runs in the same parallel phase as batch
+    // b - 1's raster, into the other half of the chunks: half the phases, and a worker that ends
+    // its share of one early takes jobs of the other instead of waiting at the phase's end. Each
+    // tile still draws the batches in order (batch b's raster is a phase after batch b - 1's).
+    // One thread, or one batch, gains nothing from it: setup, then raster.
+    const bool overlap = threads_ > 1 && batches > 1;
+    const size_t sets = overlap ? 2 : 1;
+    // The cache keeps the most chunks any draw used (one thread needs one), so alternating
+    // thread counts does not free and reallocate arenas.
+    if (cache_.chunks.size() < sets * num_chunks_) cache_.chunks.resize(sets * num_chunks_);
+    for (size_t c = 0; c < sets * num_chunks_; ++c) {
+      cache_.chunks[c].bins.resize(size_t(tiles_x_) * size_t(tiles_y_));
+      cache_.chunks[c].box_area.resize(deferred_ ? size_t(tiles_x_) * size_t(tiles_y_) : 0);
+    }
+    auto setup_of = [&](size_t b) {
+      SetupJobs jobs;
+      jobs.indices = indices;
+      jobs.first = b * kBatchTriangles;
+      jobs.count = std::min(kBatchTriangles, triangles - jobs.first);
+      jobs.per_chunk = (jobs.count + num_chunks_ - 1) / num_chunks_;
+      jobs.chunks = cache_.chunks.data() + (b % sets) * num_chunks_;
+      return jobs;
+    };
+    for (size_t b = 0; b < batches; ++b) {
+      if (!overlap) {
+        run_phase(setup_of(b), false);
+        raster_chunks_ = cache_.chunks.data();
+        run_phase(SetupJobs{}, true);
+        continue;
+      }
+      if (b == 0) run_phase(setup_of(0), false);
+      raster_chunks_ = cache_.chunks.data() + (b % sets) * num_chunks_;
+      run_phase(b + 1 < batches ? setup_of(b + 1) : SetupJobs{}, true);
     }
   }
 
  private:
+  // A batch's geometry jobs: chunk c sets up triangles [first + c * per_chunk, ...) of the batch
+  // into chunks[c] (none when `chunks` is null).
+  struct SetupJobs {
+    const uint32_t* indices = nullptr;
+    size_t first = 0, count = 0, per_chunk = 0;
+    Chunk* chunks = nullptr;
+  };
+
   // Phase 1 for one chunk.
   void setup_chunk(Chunk& chunk, const uint32_t* indices, size_t begin, size_t end) {
     chunk.records.clear();
@@ -295,13 +321,20 @@ class BinnedDraw {
     return intersect(region, geometry_.scissor());
   }
 
-  // Phase 2: tile workers take tiles in increasing order until none is left. Each worker has its
-  // own scratch in the cache (not one per thread), so what is allocated does not depend on which
-  // thread ran which tile.
-  void raster_tiles() {
-    size_t tiles = size_t(tiles_x_) * size_t(tiles_y_);
-    size_t workers = std::min<size_t>(size_t(threads_), tiles);
-    if (deferred_) {
+  // One parallel phase: the chunks of `setup` (phase 1), then, when `raster`, the tiles of the
+  // batch in raster_chunks_ (phase 2). Workers take jobs in that order until none is left: the
+  // chunks first, then the tiles with the most records. Each worker has its own scratch in the
+  // cache (not one per thread), so what is allocated does not depend on which thread ran which
+  // tile.
+  void run_phase(const SetupJobs& setup, bool raster) {
+    const size_t setup_jobs = setup.chunks != nullptr ? num_chunks_ : 0;
+    std::vector<std::pair<uint32_t, uint32_t>>& order = cache_.tile_order;
+    order.clear();
+    if (raster) order_tiles();
+    const size_t jobs = setup_jobs + order.size();
+    if (jobs == 0) return;
+    const size_t workers = std::min<size_t>(size_t(threads_), jobs);
+    if (raster && deferred_) {
       size_t records = 0;  // a tile holds at most every record of the batch once
       for (const Chunk& c : chunks()) records += c.records.used() / record_bytes_;
       if (cache_.scratch.size() < workers) cache_.scratch.resize(workers);
@@ -310,44 +343,58 @@ class BinnedDraw {
         if (cache_.scratch[w]->interps.size() < records) cache_.scratch[w]->interps.resize(records);
       }
     }
-    // Several workers take the tiles with the most records first, so that the last tiles taken
-    // are short ones and no worker is left alone with a long tile at the end of the phase.
+    std::atomic<size_t> next{0};
+    parallel_for(workers, threads_, [&](size_t worker) {
+      // Each worker takes its next job before doing the current one, so that a next tile's
+      // framebuffer lines are on their way while this one is drawn (a pair per block drawn, the
+      // rest at the end).
+      TilePrefetch ahead;
+      size_t following = next.fetch_add(1);
+      for (size_t k = following; k < jobs; k = following) {
+        following = next.fetch_add(1);
+        if (k < setup_jobs) {
+          size_t begin = std::min(setup.first + setup.count, setup.first + k * setup.per_chunk);
+          size_t end = std::min(setup.first + setup.count, begin + setup.per_chunk);
+          setup_chunk(setup.chunks[k], setup.indices, begin, end);
+          continue;
+        }
+        ahead = following >= setup_jobs && following < jobs
+                    ? tile_prefetch(order[following - setup_jobs].second)
+                    : TilePrefetch{};
+        raster_tile_job(order[k - setup_jobs].second, worker, ahead);
+        ahead.rest();
+      }
+    });
+  }
+
+  // The tiles the batch in raster_chunks_ touches, into cache_.tile_order. With several workers
+  // the tiles with the most records come first, so that the last tiles taken are short ones and
+  // no worker is left alone with a long tile at the end of the phase.
+  void order_tiles() {
     std::vector<std::pair<uint32_t, uint32_t>>& order = cache_.tile_order;
-    order.clear();
+    size_t tiles = size_t(tiles_x_) * size_t(tiles_y_);
     for (size_t tile = 0; tile < tiles; ++tile) {
       size_t records = 0;
       for (const Chunk& chunk : chunks()) records += chunk.bins[tile].size();
       if (records != 0) order.emplace_back(uint32_t(~std::bit_width(records)), uint32_t(tile));
     }
-    if (workers > 1) std::sort(order.begin(), order.end());
-    std::atomic<size_t> next{0};
-    parallel_for(workers, threads_, [&](size_t worker) {
-      // Each worker takes its next tile before drawing the current one, so that the next tile's
-      // framebuffer lines are on their way while this one is drawn (a pair per block drawn, the
-      // rest at the end).
-      TilePrefetch ahead;
-      size_t following = next.fetch_add(1);
-      for (size_t k = following; k < order.size(); k = following) {
-        following = next.fetch_add(1);
-        ahead = following < order.size() ? tile_prefetch(order[following].second) : TilePrefetch{};
-        size_t tile = order[k].second;
-        auto start = state_.tile_times ? std::chrono::steady_clock::now()
-                                       : std::chrono::steady_clock::time_point{};
-        // A clear still pending on the tile is written now, into the cache the tile is drawn in.
-        target_.framebuffer->prepare_tile(int(tile % size_t(tiles_x_)),
-                                          int(tile / size_t(tiles_x_)));
-        if (deferred_ && worth_deferring(tile)) {
-          resolve_and_shade_tile(tile, *cache_.scratch[worker], ahead);
-        } else {
-          raster_tile(tile, deferred_ ? cache_.scratch[worker].get() : nullptr, ahead);
-        }
-        ahead.rest();
-        if (state_.tile_times) {  // the `cost` debug view; one thread owns the tile
-          std::chrono::duration<double> spent = std::chrono::steady_clock::now() - start;
-          state_.tile_times->seconds[tile] += spent.count();
-        }
-      }
-    });
+    if (threads_ > 1) std::sort(order.begin(), order.end());
+  }
+
+  void raster_tile_job(size_t tile, size_t worker, TilePrefetch& ahead) {
+    auto start = state_.tile_times ? std::chrono::steady_clock::now()
+                                   : std::chrono::steady_clock::time_point{};
+    // A clear still pending on the tile is written now, into the cache the tile is drawn in.
+    target_.framebuffer->prepare_tile(int(tile % size_t(tiles_x_)), int(tile / size_t(tiles_x_)));
+    if (deferred_ && worth_deferring(tile)) {
+      resolve_and_shade_tile(tile, *cache_.scratch[worker], ahead);
+    } else {
+      raster_tile(tile, deferred_ ? cache_.scratch[worker].get() : nullptr, ahead);
+    }
+    if (state_.tile_times) {  // the `cost` debug view; one thread owns the tile
+      std::chrono::duration<double> spent = std::chrono::steady_clock::now() - start;
+      state_.tile_times->seconds[tile] += spent.count();
+    }
   }
 
   // A tile's colour and depth (16 KiB each, contiguous: framebuffer.hpp) for the cache, for a
@@ -444,8 +491,8 @@ class BinnedDraw {
     visibility.reset();
   }
 
-  // The chunks of this draw.
-  std::span<const Chunk> chunks() const { return {cache_.chunks.data(), num_chunks_}; }
+  // The chunks of the batch being rasterized.
+  std::span<const Chunk> chunks() const { return {raster_chunks_, num_chunks_}; }
 
   static const TriRecord& record(const Chunk& chunk, uint32_t offset) {
     return *reinterpret_cast<const TriRecord*>(chunk.records.data() + offset);
@@ -463,6 +510,7 @@ class BinnedDraw {
   bool scanline_ = false;  // records hold their vertices (RasterAlgorithm::kScanline)
   size_t record_bytes_ = 0;
   size_t num_chunks_ = 1;
+  const Chunk* raster_chunks_ = nullptr;  // the half of the chunks phase 2 reads
   int tiles_x_ = 0, tiles_y_ = 0;
 };
 
