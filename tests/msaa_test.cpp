@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "counting_shader.hpp"
 #include "raster/raster.hpp"
 #include "raster/sample_coverage.hpp"
 #include "softrast/renderer.hpp"
@@ -321,19 +322,7 @@ TEST(Msaa, RotatedSquareEdgeMatchesAnalyticArea) {
   }
 }
 
-// Counts the lanes shaded (threads = 1, so the counter is not shared).
-struct CountingShader {
-  static constexpr int kVaryings = 0;
-  const glm::vec4* positions = nullptr;
-  mutable int64_t shaded = 0;
-  glm::vec4 vertex(uint32_t index, float*) const { return positions[index]; }
-  template <int N>
-  void shade(Fragments<N>& f) const {
-    shaded += __builtin_popcount(simd::bits(f.live));
-    f.color = {simd::Float<N>(1.0f), simd::Float<N>(0.0f), simd::Float<N>(0.0f),
-               simd::Float<N>(1.0f)};
-  }
-};
+using test::CountingShader;
 
 // The fragment shader runs once per pixel with at least one covered sample, per triangle, not
 // once per sample: two triangles sharing an edge shade the pixels along it once each.
@@ -371,7 +360,7 @@ TEST(Msaa, ShadesOncePerPixelAndTriangle) {
         }
       }
     }
-    EXPECT_EQ(shader.shaded, expect) << n << " samples";
+    EXPECT_EQ(shader.shaded.load(), expect) << n << " samples";
   }
 }
 

@@ -5,13 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cstring>
 #include <limits>
 #include <map>
 #include <random>
 #include <utility>
 
+#include "counting_shader.hpp"
 #include "pipeline/tile_kernels.hpp"
 #include "raster/raster.hpp"
 #include "softrast/shader.hpp"
@@ -179,20 +179,6 @@ TEST(TileKernel, ResolveComputesTheFragmentStagesDepth) {
   }
 }
 
-// Counts the pixels it shades (the live lanes of its calls), from any thread.
-struct LaneCounter {
-  static constexpr int kVaryings = 0;
-  const glm::vec4* positions = nullptr;
-  mutable std::atomic<int64_t> shaded{0};
-  glm::vec4 vertex(uint32_t index, float*) const { return positions[index]; }
-  template <int N>
-  void shade(Fragments<N>& f) const {
-    shaded += __builtin_popcount(simd::bits(f.live));
-    f.color = {simd::Float<N>(1.0f), simd::Float<N>(1.0f), simd::Float<N>(1.0f),
-               simd::Float<N>(1.0f)};
-  }
-};
-
 // A framebuffer stores the blocks cut by the image's right and bottom edges whole, but only the
 // image's pixels are shaded: a mesh that covers more than the image shades each pixel once (the
 // fill rule gives a pixel to one triangle), for images whose size is not a multiple of 4 and one
@@ -232,7 +218,7 @@ TEST(TileKernel, ShadesOnlyTheImagesPixels) {
             state.threads = threads;
             Framebuffer fb(width, height);
             fb.clear({0.0f, 0.0f, 0.0f, 0.0f});
-            LaneCounter shader;
+            test::CountingShader shader;
             shader.positions = clip.data();
             draw(fb, state, shader, indices, uint32_t(clip.size()));
             EXPECT_EQ(shader.shaded.load(), int64_t(width) * height)

@@ -145,10 +145,9 @@ template <class T, class V>
 }
 #endif
 // (Macros, not lambdas: GCC gives a lambda that returns a vector the default target's ABI.)
-#define SOFTRAST_HALF_DOUBLE(v) half_double(v)
 #define SOFTRAST_HALF_FLOAT(v) __builtin_convertvector((v), FH)
 // Vertex k's float f (z, 1/w, x and y residual) for half h of the lanes, in double.
-#define SOFTRAST_FIELD(k, f) SOFTRAST_HALF_DOUBLE(half<FH>(vertex_floats[k][f], h))
+#define SOFTRAST_FIELD(k, f) half_double(half<FH>(vertex_floats[k][f], h))
 
 [[gnu::always_inline]] inline void setup_plane_lanes(const TriangleBatch& b, TriangleLanes& out) {
   // z, 1/w and the residuals of each vertex (PackedVertex's floats 2 to 5), by lane.
@@ -178,10 +177,10 @@ template <class T, class V>
     // The snapped basis (to_pixels: times 2^-8, exact) and the exact one (the residuals).
     const DH px = DH{} + 0x1p-8;
     const IH x0 = half<IH>(out.x[0], h), y0 = half<IH>(out.y[0], h);
-    const DH gdx1 = SOFTRAST_HALF_DOUBLE(half<IH>(out.x[1], h) - x0) * px;
-    const DH gdx2 = SOFTRAST_HALF_DOUBLE(half<IH>(out.x[2], h) - x0) * px;
-    const DH gdy1 = SOFTRAST_HALF_DOUBLE(half<IH>(out.y[1], h) - y0) * px;
-    const DH gdy2 = SOFTRAST_HALF_DOUBLE(half<IH>(out.y[2], h) - y0) * px;
+    const DH gdx1 = half_double(half<IH>(out.x[1], h) - x0) * px;
+    const DH gdx2 = half_double(half<IH>(out.x[2], h) - x0) * px;
+    const DH gdy1 = half_double(half<IH>(out.y[1], h) - y0) * px;
+    const DH gdy2 = half_double(half<IH>(out.y[2], h) - y0) * px;
     const DH rx0 = px * SOFTRAST_FIELD(0, 2), ry0 = px * SOFTRAST_FIELD(0, 3);
     const DH edx1 = gdx1 + (px * SOFTRAST_FIELD(1, 2) - rx0),
              edx2 = gdx2 + (px * SOFTRAST_FIELD(2, 2) - rx0);
@@ -206,8 +205,8 @@ template <class T, class V>
       pdy = (da2 * dx1 - da1 * dx2) * inv_area2;
       p0 = shifted ? a0 - pdx * ox - pdy * oy : a0;
     };
-    store_half(out.x_ref, h, SOFTRAST_HALF_FLOAT(SOFTRAST_HALF_DOUBLE(x0) * px));
-    store_half(out.y_ref, h, SOFTRAST_HALF_FLOAT(SOFTRAST_HALF_DOUBLE(y0) * px));
+    store_half(out.x_ref, h, SOFTRAST_HALF_FLOAT(half_double(x0) * px));
+    store_half(out.y_ref, h, SOFTRAST_HALF_FLOAT(half_double(y0) * px));
     DH p[3];
     plane(SOFTRAST_FIELD(0, 0), SOFTRAST_FIELD(1, 0), SOFTRAST_FIELD(2, 0), p[0], p[1], p[2]);
     for (int c = 0; c < 3; ++c) store_half(out.z[c], h, p[c]);
@@ -215,14 +214,13 @@ template <class T, class V>
     plane(w[0], w[1], w[2], p[0], p[1], p[2]);
     for (int c = 0; c < 3; ++c) store_half(out.inv_w[c], h, SOFTRAST_HALF_FLOAT(p[c]));
     for (int i = 0; i < b.num_varyings; ++i) {
-#define SOFTRAST_VAR(k) SOFTRAST_HALF_DOUBLE(half<FH>(var_floats[k][i], h)) * w[k]
+#define SOFTRAST_VAR(k) half_double(half<FH>(var_floats[k][i], h)) * w[k]
       plane(SOFTRAST_VAR(0), SOFTRAST_VAR(1), SOFTRAST_VAR(2), p[0], p[1], p[2]);
 #undef SOFTRAST_VAR
       for (int c = 0; c < 3; ++c) store_half(out.var[i][c], h, SOFTRAST_HALF_FLOAT(p[c]));
     }
   }
 }
-#undef SOFTRAST_HALF_DOUBLE
 #undef SOFTRAST_HALF_FLOAT
 #undef SOFTRAST_FIELD
 
