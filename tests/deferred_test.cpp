@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "core/store_mode.hpp"
 #include "softrast/shader.hpp"
 #include "softrast/simd_level.hpp"
 
@@ -152,18 +153,26 @@ Buffers render(const std::vector<const Scene*>& scenes, RenderState state, int t
   return read_back(fb);
 }
 
-// One and two threads, with the kernels of every SIMD level this CPU has.
+// One and two threads, with the kernels of every SIMD level this CPU has; at AVX2 with the depth
+// resolve's winners written both ways (masked stores and blends, core/store_mode.hpp).
 void expect_same_as_reference(const std::vector<const Scene*>& scenes, const RenderState& state,
                               const char* what) {
   Buffers reference = render(scenes, state, 1, true);
   SimdLevel cap = simd_level();  // restored after: SOFTRAST_SIMD may have capped it
+  const bool masked = detail::avx2_masked_stores();
   for (int level = 0; level <= int(cap); ++level) {
     set_simd_level(SimdLevel(level));
-    for (int threads : {1, 2}) {
-      EXPECT_TRUE(render(scenes, state, threads, false) == reference)
-          << what << ", threads " << threads << ", " << simd_level_name(SimdLevel(level));
+    for (bool masked_stores : {true, false}) {
+      if (!masked_stores && SimdLevel(level) != SimdLevel::kAvx2) continue;
+      detail::set_avx2_masked_stores(masked_stores);
+      for (int threads : {1, 2}) {
+        EXPECT_TRUE(render(scenes, state, threads, false) == reference)
+            << what << ", threads " << threads << ", " << simd_level_name(SimdLevel(level))
+            << (masked_stores ? "" : ", blends");
+      }
     }
   }
+  detail::set_avx2_masked_stores(masked);
   set_simd_level(cap);
 }
 

@@ -186,7 +186,8 @@ struct DepthTerms {
 }
 
 // Depth test of the lanes of `mask` (bits of the group's pixels) and the write of the winners.
-template <bool kLessEqual>
+// kBlend (AVX2): by blends and whole stores instead of masked stores (core/store_mode.hpp).
+template <bool kLessEqual, bool kBlend>
 [[gnu::always_inline]] inline void test_and_write(F z, uint32_t mask, int32_t id, float* depth,
                                                   int32_t* ids) {
 #if SOFTRAST_LANES == 16
@@ -204,11 +205,14 @@ template <bool kLessEqual>
   I covered = ((I{} + int32_t(mask)) & bit) != 0;
   I pass = (kLessEqual ? (z <= stored) : (z < stored)) & covered;
 #if SOFTRAST_LANES == 8
-  // AVX2: the winners' depth and id by masked stores (VMASKMOVPS, VPMASKMOVD), as AVX-512 does;
-  // blending into the loaded values and storing them whole read the ids for nothing.
-  _mm256_maskstore_ps(depth, reinterpret_cast<__m256i>(pass), reinterpret_cast<__m256>(z));
-  _mm256_maskstore_epi32(ids, reinterpret_cast<__m256i>(pass), _mm256_set1_epi32(id));
-#else
+  if constexpr (!kBlend) {
+    // AVX2: the winners' depth and id by masked stores (VMASKMOVPS, VPMASKMOVD), as AVX-512
+    // does; blending into the loaded values and storing them whole read the ids for nothing.
+    _mm256_maskstore_ps(depth, reinterpret_cast<__m256i>(pass), reinterpret_cast<__m256>(z));
+    _mm256_maskstore_epi32(ids, reinterpret_cast<__m256i>(pass), _mm256_set1_epi32(id));
+    return;
+  }
+#endif
   I winner;
   std::memcpy(&winner, ids, sizeof(I));
   stored = pass ? z : stored;
@@ -216,10 +220,9 @@ template <bool kLessEqual>
   std::memcpy(depth, &stored, sizeof(F));
   std::memcpy(ids, &winner, sizeof(I));
 #endif
-#endif
 }
 
-template <bool kLessEqual>
+template <bool kLessEqual, bool kBlend>
 [[gnu::always_inline]] inline void resolve_lanes(const DepthTerms& d, int x, int y, uint32_t mask,
                                                  float* depth, int32_t* ids) {
   if (d.constant) {
@@ -227,7 +230,7 @@ template <bool kLessEqual>
     for (int g = 0; g < kGroups; ++g) {
       uint32_t group_mask = (mask >> (g * kLanes)) & ((1u << kLanes) - 1u);
       if (kGroups > 1 && group_mask == 0) continue;
-      test_and_write<kLessEqual>(z, group_mask, d.id, depth + g * kLanes, ids + g * kLanes);
+      test_and_write<kLessEqual, kBlend>(z, group_mask, d.id, depth + g * kLanes, ids + g * kLanes);
     }
     return;
   }
@@ -237,14 +240,22 @@ template <bool kLessEqual>
     uint32_t group_mask = (mask >> (g * kLanes)) & ((1u << kLanes) - 1u);
     if (kGroups > 1 && group_mask == 0) continue;
     F z = clamp01(__builtin_convertvector(x_term[g] + y_term[g], F));
-    test_and_write<kLessEqual>(z, group_mask, d.id, depth + g * kLanes, ids + g * kLanes);
+    test_and_write<kLessEqual, kBlend>(z, group_mask, d.id, depth + g * kLanes, ids + g * kLanes);
   }
 }
 
 // ---------------------------------------------------------------------------------------------
 // One record in one tile.
 
-enum class Mode { kImmediate, kLess, kLessEqual };
+// The deferred modes: the depth function, and the AVX2 resolve's way of writing (kBlend: see
+// test_and_write).
+enum class Mode { kImmediate, kLess, kLessEqual, kLessBlend, kLessEqualBlend };
+constexpr bool is_less_equal(Mode m) {
+  return m == Mode::kLessEqual || m == Mode::kLessEqualBlend;
+}
+constexpr bool is_blend(Mode m) {
+  return m == Mode::kLessBlend || m == Mode::kLessEqualBlend;
+}
 
 // The pixels of the block at (x, y) inside the tile's region (only the image's last row and
 // column of tiles are cut).
@@ -292,7 +303,7 @@ struct BlockTarget {
       TileVisibility& v = *job.visibility;
       int b = v.block_index(x, y);
       if (!v.loaded(b)) load_depth(v, b, x, y);
-      resolve_lanes<kMode == Mode::kLessEqual>(depth, x, y, bits, v.depth[b], v.id[b]);
+      resolve_lanes<is_less_equal(kMode), is_blend(kMode)>(depth, x, y, bits, v.depth[b], v.id[b]);
     }
   }
   // A whole 16x16 area at (x, y), inside the triangle and the tile's region, into the depth
@@ -311,8 +322,8 @@ struct BlockTarget {
         load_depth(v, b + i, x + kBlockSize * i, row_y);
       }
       for (int i = 0; i < 4; ++i) {
-        resolve_lanes<kMode == Mode::kLessEqual>(depth, x + kBlockSize * i, row_y, 0xffffu,
-                                                 v.depth[b + i], v.id[b + i]);
+        resolve_lanes<is_less_equal(kMode), is_blend(kMode)>(depth, x + kBlockSize * i, row_y,
+                                                             0xffffu, v.depth[b + i], v.id[b + i]);
       }
     }
   }
@@ -494,7 +505,13 @@ void raster_immediate(TileJob& job, const std::byte* arena, const uint32_t* offs
   raster_records<Mode::kImmediate>(job, arena, offsets, count);
 }
 void raster_deferred(TileJob& job, const std::byte* arena, const uint32_t* offsets, size_t count) {
-  if (job.less_equal) {
+  if (kLanes == 8 && !avx2_masked_stores()) {
+    if (job.less_equal) {
+      raster_records<Mode::kLessEqualBlend>(job, arena, offsets, count);
+    } else {
+      raster_records<Mode::kLessBlend>(job, arena, offsets, count);
+    }
+  } else if (job.less_equal) {
     raster_records<Mode::kLessEqual>(job, arena, offsets, count);
   } else {
     raster_records<Mode::kLess>(job, arena, offsets, count);
@@ -508,9 +525,12 @@ void resolve_block(const DepthPlaneRef& plane, int x, int y, uint32_t mask, int3
   in.z = plane.z;
   DepthTerms d;
   depth_terms(in, id, x, x + kBlockSize, y, y + kBlockSize, d);
+  const bool blend = kLanes == 8 && !avx2_masked_stores();
   if (less_equal) {
-    resolve_lanes<true>(d, x, y, mask, depth, ids);
+    blend ? resolve_lanes<true, true>(d, x, y, mask, depth, ids)
+          : resolve_lanes<true, false>(d, x, y, mask, depth, ids);
   } else {
-    resolve_lanes<false>(d, x, y, mask, depth, ids);
+    blend ? resolve_lanes<false, true>(d, x, y, mask, depth, ids)
+          : resolve_lanes<false, false>(d, x, y, mask, depth, ids);
   }
 }

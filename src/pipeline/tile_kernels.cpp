@@ -5,6 +5,7 @@
 
 #include "core/isa_target.hpp"
 #include "core/prefetch.hpp"
+#include "core/store_mode.hpp"
 
 #include <immintrin.h>
 
