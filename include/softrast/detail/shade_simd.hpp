@@ -298,9 +298,17 @@ bool reads_derivatives(const S& s) {
 // Shades the covered pixels (`mask`) of the 4x4 block at (x, y) with shader S on N-lane vectors.
 // kCommon compiles the state most draws use (depth less with writes, opaque) with its branches
 // resolved; `target.resolved` means visibility is already decided (see ShadeTarget).
-template <class S, int N, bool kCommon>
+//
+// kHalf (a block of two parts, AVX2's two registers of 8 lanes; kCommon only): only the two rows
+// from y (0 and 1, or 2 and 3 of the block) are covered, `mask` their 8 bits. Part 0 takes them
+// and part 1 is made a copy of it, so each lane of part 0 gets the operations, and the bits, of
+// the whole-block path; the compiler drops what part 1 would add, since only part 0 is stored.
+// Quads stay whole (a quad's four lanes are in one part), so derivatives are the whole block's.
+// Most blocks of small triangles are such halves (spheres_1m: 84 % of the fragment stage's).
+template <class S, int N, bool kCommon, bool kHalf = false>
 SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& target,
                                            const Interpolants& in, int x, int y, uint32_t mask) {
+  static_assert(!kHalf || (kCommon && simd::Float<N>::kParts == 2 && !WritesDepth<S>));
   using F = simd::Float<N>;
   using I = simd::Int<N>;
   constexpr int kN = S::kVaryings > 0 ? S::kVaryings : 1;
@@ -316,9 +324,14 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   Fragments<N> f;
   f.x = simd::to_float(I(x) + simd::lane_column<N>()) + F(0.5f);
   f.y = simd::to_float(I(y) + simd::lane_row<N>()) + F(0.5f);
+  if constexpr (kHalf) {
+    f.x.p[1] = f.x.p[0];
+    f.y.p[1] = f.y.p[0];
+  }
   F dx = f.x - F(in.x_ref), dy = f.y - F(in.y_ref);
   F z = simd::clamp(eval_plane<N>(in.z, dx, dy), F(0.0f), F(1.0f));
   f.live = simd::lanes_of<N>(mask);
+  if constexpr (kHalf) f.live.p[1] = typename simd::Native<N>::I{};
   f.opaque = blend_mode == BlendMode::kOpaque;
 
   // The framebuffer stores a block's 16 pixels together (framebuffer.hpp): one aligned vector
@@ -326,8 +339,14 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   // only covered pixels (never padding) are live.
   float* depth_at = fb.depth_block(x, y);
   F stored;
+  if constexpr (kHalf) stored = F(0.0f);  // (GCC cannot tell that the write below needs the test)
   if (depth_test) {
-    stored = F::load(depth_at);
+    if constexpr (kHalf) {
+      std::memcpy(&stored.p[0], depth_at, sizeof stored.p[0]);
+      stored.p[1] = stored.p[0];
+    } else {
+      stored = F::load(depth_at);
+    }
     if (!kLateDepth) {  // early depth test: the shader cannot change depth
       f.live = f.live & depth_passes<N>(depth_func, z, stored);
       if (!simd::any(f.live)) return;
@@ -363,6 +382,23 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   const uint32_t live = simd::bits(f.live);
   if (live == 0) return;
   int32_t* color_at = reinterpret_cast<int32_t*>(fb.color_block(x, y));
+  if constexpr (kHalf) {  // part 0 alone, to the block's rows from y
+    if (depth_test && depth_write) {
+      const F out = live == 0xffu ? z : simd::select(f.live, z, stored);
+      std::memcpy(depth_at, &out.p[0], sizeof out.p[0]);
+    }
+    const I packed = f.has_rgba8 ? f.rgba8 : pack_rgba8<N>(f.color);
+    if (live == 0xffu) {
+      std::memcpy(color_at, &packed.p[0], sizeof packed.p[0]);
+    } else {
+      I old;
+      std::memcpy(&old.p[0], color_at, sizeof old.p[0]);
+      old.p[1] = old.p[0];
+      const I out = simd::select(f.live, packed, old);
+      std::memcpy(color_at, &out.p[0], sizeof out.p[0]);
+    }
+    return;
+  }
   if (depth_test && depth_write) {
     (live == 0xffffu ? z : simd::select(f.live, z, stored)).store(depth_at);
   }
@@ -586,6 +622,12 @@ SOFTRAST_SIMD_INLINE void shade_block_level(const void* shader, const ShadeTarge
   bool common = !WritesDepth<S> && st.depth_test && st.depth_func == DepthFunc::kLess &&
                 st.depth_write && st.blend == BlendMode::kOpaque;
   if (common || target.resolved) {
+    if constexpr (simd::Float<N>::kParts == 2 && !WritesDepth<S>) {  // AVX2: halves alone
+      if ((mask & 0xffu) == 0)
+        return shade_block_wide<S, N, true, true>(s, target, interp, x, y + 2, mask >> 8);
+      if ((mask >> 8) == 0)
+        return shade_block_wide<S, N, true, true>(s, target, interp, x, y, mask);
+    }
     shade_block_wide<S, N, true>(s, target, interp, x, y, mask);
   } else {
     shade_block_wide<S, N, false>(s, target, interp, x, y, mask);
