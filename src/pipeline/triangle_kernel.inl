@@ -174,6 +174,9 @@ template <class T, class V>
     }
   }
   for (int h = 0; h < 2; ++h) {
+    // A half with no lane ready (back faces, specks, the end of a mesh's front half): no planes
+    // are read from it.
+    if (((out.ready >> (h * kH)) & ((1u << kH) - 1u)) == 0) continue;
     // The snapped basis (to_pixels: times 2^-8, exact) and the exact one (the residuals).
     const DH px = DH{} + 0x1p-8;
     const IH x0 = half<IH>(out.x[0], h), y0 = half<IH>(out.y[0], h);
