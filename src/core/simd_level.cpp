@@ -95,22 +95,31 @@ SOFTRAST_SIMD_INLINE double time_pairs(const int32_t* table, bool loads, uint32_
   return time_pairs<16>(table, loads, sink);
 }
 
-// Whether loads beat the instruction: the fastest of seven timings of each, taken in turn (so
-// that a change of clock speed or a busy moment falls on both), loads chosen only when at least
-// a fifth faster.
+// Whether the alternative way beats the usual one: `time(alternative)` times one way in
+// nanoseconds; the fastest of seven timings of each, taken in turn (so that a change of clock
+// speed or a busy moment falls on both), the alternative chosen only when at least a fifth
+// faster. For the gathers' loads and for the depth resolve's blends.
+template <class Time>
+bool alternative_is_faster(Time time) {
+  double usual = 1e300, alternative = 1e300;
+  for (int trial = 0; trial < 7; ++trial) {
+    usual = std::min(usual, time(false));
+    alternative = std::min(alternative, time(true));
+  }
+  return alternative < 0.8 * usual;
+}
+
+// Whether loads beat the gather instruction.
 template <class Time>
 bool loads_are_faster(Time time) {
   std::vector<int32_t> table(kTableSize + 1);  // + 1: the last lane's pair may start at the end
   for (int i = 0; i <= kTableSize; ++i) table[size_t(i)] = i * 2654435761u;
   uint32_t sink = 0;
-  double instruction = 1e300, loads = 1e300;
-  for (int trial = 0; trial < 7; ++trial) {
-    instruction = std::min(instruction, time(table.data(), false, sink));
-    loads = std::min(loads, time(table.data(), true, sink));
-  }
+  const bool faster =
+      alternative_is_faster([&](bool loads) { return time(table.data(), loads, sink); });
   volatile uint32_t keep = sink;  // the reads must happen
   (void)keep;
-  return loads < 0.8 * instruction;
+  return faster;
 }
 
 std::optional<GatherMode> gather_mode_from_env() {
@@ -168,19 +177,14 @@ void settle_gathers() {
   return std::chrono::duration<double, std::nano>(end - start).count();
 }
 
-// Masked stores unless blends are at least a fifth faster: the fastest of seven timings of each,
-// taken in turn (as loads_are_faster).
+// Masked stores unless blends are at least a fifth faster (alternative_is_faster).
 bool masked_stores_settle() {
   if (const char* env = std::getenv("SOFTRAST_MASKED_STORES")) return std::string_view(env) != "0";
   if (cpu_simd_level() < SimdLevel::kAvx2) return true;  // (no AVX2 kernel runs)
   std::vector<float> depth(8 * 256, 1.0f);
   std::vector<int32_t> ids(8 * 256, 0);
-  double masked = 1e300, blends = 1e300;
-  for (int trial = 0; trial < 7; ++trial) {
-    masked = std::min(masked, time_stores8(depth.data(), ids.data(), true));
-    blends = std::min(blends, time_stores8(depth.data(), ids.data(), false));
-  }
-  return !(blends < 0.8 * masked);
+  return !alternative_is_faster(
+      [&](bool blends) { return time_stores8(depth.data(), ids.data(), !blends); });
 }
 
 std::atomic<bool>& masked_stores_flag() {
