@@ -289,18 +289,26 @@ class BinnedDraw {
     finish_record(chunk, offset, ordered, area);
   }
 
+  // Inline, for the usual triangle of a dense mesh: one tile, all of it; the rest out of line
+  // (with it inline too, the function kept six registers saved and restored per record).
   void bin(Chunk& chunk, const PixelRect& bounds, uint32_t offset) {
     // The bounds lie inside the scissor: no coordinate is negative.
     int tx0 = int(unsigned(bounds.x0) / kTileSize), tx1 = int(unsigned(bounds.x1 - 1) / kTileSize);
     int ty0 = int(unsigned(bounds.y0) / kTileSize), ty1 = int(unsigned(bounds.y1 - 1) / kTileSize);
-    if (tx0 == tx1 && ty0 == ty1) {  // the usual triangle of a dense mesh: one tile, all of it
-      size_t tile = size_t(ty0) * tiles_x_ + tx0;
-      chunk.bins[tile].push_back(offset);
-      if (!chunk.box_area.empty()) {
-        chunk.box_area[tile] += int64_t(bounds.x1 - bounds.x0) * (bounds.y1 - bounds.y0);
-      }
+    if (tx0 != tx1 || ty0 != ty1) {
+      bin_tiles(chunk, bounds, offset, tx0, ty0, tx1, ty1);
       return;
     }
+    size_t tile = size_t(ty0) * tiles_x_ + tx0;
+    chunk.bins[tile].push_back(offset);
+    if (!chunk.box_area.empty()) {
+      chunk.box_area[tile] += int64_t(bounds.x1 - bounds.x0) * (bounds.y1 - bounds.y0);
+    }
+  }
+
+  // bin() for a triangle whose bounds span tiles [tx0, tx1] x [ty0, ty1].
+  [[gnu::noinline]] void bin_tiles(Chunk& chunk, const PixelRect& bounds, uint32_t offset, int tx0,
+                                   int ty0, int tx1, int ty1) {
     for (int ty = ty0; ty <= ty1; ++ty) {
       for (int tx = tx0; tx <= tx1; ++tx) chunk.bins[size_t(ty) * tiles_x_ + tx].push_back(offset);
     }
