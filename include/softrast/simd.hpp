@@ -425,6 +425,12 @@ inline void sqrt(const Native<4>::F& a, Native<4>::F& r) {
       _mm512_maskz_sqrt_ps(__mmask16(0xffff), __m512(a)));  // maskz: no undefined source
 }
 
+// r = floor(a), lane by lane (VROUNDPS): AVX2's texel addresses (texture_simd.hpp's texel_floor);
+// the baseline truncates and corrects instead (SSE2 has no rounding instruction).
+[[gnu::target("avx")]] inline void floor(const Native<8>::F& a, Native<8>::F& r) {
+  r = Native<8>::F(_mm256_round_ps(__m256(a), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
+}
+
 // r = a * b + c, fused (one rounding) where the level has FMA (AVX2 with FMA, AVX-512); two
 // roundings at SSE2 and SSE4, so the levels may differ in the last bit.
 inline void fmadd(const Native<4>::F& a, const Native<4>::F& b, const Native<4>::F& c,

@@ -23,6 +23,14 @@ SOFTRAST_SIMD_INLINE simd::Int<N> texel_floor(const simd::Float<N>& x, simd::Flo
   using F = simd::Float<N>;
   simd::Int<N> ok = (x > F(-1.0e9f)) & (x < F(1.0e9f));
   F xs = simd::select(ok, x, F(0.0f));
+  if constexpr (N == 8) {
+    // The floor instruction: the same whole part (exact in float below 1e9), so the same texel
+    // and fraction (of -0: +0 here, -0 below; both weigh 0).
+    F whole;
+    for (int k = 0; k < F::kParts; ++k) simd::isa::floor(xs.p[k], whole.p[k]);
+    fraction = xs - whole;
+    return simd::to_int(whole);
+  }
   simd::Int<N> i = simd::to_int(xs);  // truncates towards zero
   i = i + (simd::to_float(i) > xs);   // the mask is -1 where truncation went up
   fraction = xs - simd::to_float(i);
