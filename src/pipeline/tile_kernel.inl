@@ -331,11 +331,16 @@ struct BlockTarget {
 
 // Exact block classification against the three edges, as tile_raster.cpp's: E is linear, so its
 // extremes over the block's samples are at the corner samples picked by the signs of a and b.
+// The three edges' values sit in the first three lanes of one vector of four int64 (the fourth
+// lane 0, never negative), so a block's test is two additions and two sign masks, and stepping to
+// the next block one addition (as scalars, the three edges' values, extents and steps did not fit
+// the registers: each block reloaded them and multiplied its position out, about 45 instructions).
+typedef int64_t E4 __attribute__((vector_size(32)));
 struct EdgeExtents {
-  int64_t lo[3], hi[3];  // added to E at the block's first sample: its minimum and maximum
+  E4 lo, hi;  // added to E at the block's first sample: its minimum and maximum
 };
 [[gnu::always_inline]] inline EdgeExtents edge_extents(const TriRecord& t, int size) {
-  EdgeExtents x;
+  EdgeExtents x{};
   int64_t span = int64_t(size - 1) * kSubpixelOne;
   for (int k = 0; k < 3; ++k) {
     int64_t ax = t.edge[k].a * span, by = t.edge[k].b * span;
@@ -344,14 +349,22 @@ struct EdgeExtents {
   }
   return x;
 }
+// The sign bits of the four lanes as bits 0 to 3.
+[[gnu::always_inline]] inline uint32_t sign_bits4(const E4& v) {
+#if SOFTRAST_LANES == 4
+  __m128i lo, hi;
+  std::memcpy(&lo, &v, 16);
+  std::memcpy(&hi, reinterpret_cast<const char*>(&v) + 16, 16);
+  return uint32_t(_mm_movemask_pd(_mm_castsi128_pd(lo)) |
+                  (_mm_movemask_pd(_mm_castsi128_pd(hi)) << 2));
+#else
+  return uint32_t(_mm256_movemask_pd(reinterpret_cast<__m256d>(v)));
+#endif
+}
 enum class Test { kOutside, kInside, kPartial };
-[[gnu::always_inline]] inline Test classify(const int64_t e[3], const EdgeExtents& x) {
-  bool inside = true;
-  for (int k = 0; k < 3; ++k) {
-    if (e[k] + x.hi[k] < 0) return Test::kOutside;
-    if (e[k] + x.lo[k] < 0) inside = false;
-  }
-  return inside ? Test::kInside : Test::kPartial;
+[[gnu::always_inline]] inline Test classify(const E4& e, const EdgeExtents& x) {
+  if (sign_bits4(e + x.hi) != 0) return Test::kOutside;
+  return sign_bits4(e + x.lo) != 0 ? Test::kPartial : Test::kInside;
 }
 
 // Edge values at the first sample of block (x, y), from those at (x0, y0) (exact int64).
@@ -362,6 +375,17 @@ struct EdgeGrid {
     for (int k = 0; k < 3; ++k) {
       e[k] = origin[k] + step_x[k] * (x - x0) + step_y[k] * (y - y0);
     }
+  }
+  // The same in a vector (by reference: no wide vector is passed or returned by value in the
+  // baseline copy of this file, whose ABI has no 32-byte registers).
+  [[gnu::always_inline]] void at(int x, int y, E4& e) const {
+    e = E4{};
+    for (int k = 0; k < 3; ++k) e[k] = origin[k] + step_x[k] * (x - x0) + step_y[k] * (y - y0);
+  }
+  // The change of the values from one block to the next right.
+  [[gnu::always_inline]] void block_step_x(E4& d) const {
+    d = E4{};
+    for (int k = 0; k < 3; ++k) d[k] = step_x[k] * kBlockSize;
   }
 };
 
@@ -404,11 +428,12 @@ template <Mode kMode, class V, class T>
   }
   // Larger: 16x16 blocks, then 4x4 blocks, trivially rejected or accepted (a block inside every
   // edge is emitted without per-pixel tests); only the rest is tested pixel by pixel.
-  EdgeExtents mid = edge_extents(t, kMidBlockSize), small = edge_extents(t, kBlockSize);
+  const EdgeExtents mid = edge_extents(t, kMidBlockSize), small = edge_extents(t, kBlockSize);
+  E4 next_block, e;
+  grid.block_step_x(next_block);
   int mx0 = area.x0 & ~(kMidBlockSize - 1), my0 = area.y0 & ~(kMidBlockSize - 1);
   for (int my = my0; my < area.y1; my += kMidBlockSize) {
     for (int mx = mx0; mx < area.x1; mx += kMidBlockSize) {
-      int64_t e[3];
       grid.at(mx, my, e);
       Test test = classify(e, mid);
       if (test == Test::kOutside) continue;
@@ -423,17 +448,21 @@ template <Mode kMode, class V, class T>
       // Only blocks that overlap the area (the 32-bit bound in fixed_point.hpp relies on it).
       int y_end = std::min(my + kMidBlockSize, area.y1),
           x_end = std::min(mx + kMidBlockSize, area.x1);
+      const int x_begin = std::max(mx, bx0);
       for (int y = std::max(my, by0); y < y_end; y += kBlockSize) {
-        for (int x = std::max(mx, bx0); x < x_end; x += kBlockSize) {
-          Test sub = test;
-          if (test == Test::kPartial) {
-            grid.at(x, y, e);
-            sub = classify(e, small);
-          }
+        if (test == Test::kInside) {
+          for (int x = x_begin; x < x_end; x += kBlockSize) emit(x, y, region(x, y));
+          continue;
+        }
+        // A partial area: each block classified, the edge values stepped from block to block.
+        grid.at(x_begin, y, e);
+        for (int x = x_begin; x < x_end; x += kBlockSize, e += next_block) {
+          Test sub = classify(e, small);
           if (sub == Test::kInside) {
             emit(x, y, region(x, y));
           } else if (sub == Test::kPartial) {
-            partial_block(x, y, e);  // (only a partial area has partial blocks: e is at x, y)
+            const int64_t values[3] = {e[0], e[1], e[2]};
+            partial_block(x, y, values);
           }
         }
       }
