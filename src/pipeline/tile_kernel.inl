@@ -104,12 +104,15 @@ template <class V, class T>
     static_assert(sizeof(o.off) == 3 * 16 * sizeof(int64_t));
     return coverage_bits_64(e, reinterpret_cast<const int64_t*>(o.off));
   } else {
-    uint32_t bits = 0;
+    // A pixel is outside where the or of its three values is negative: its sign bit, read
+    // straight off (GCC had made `all >= 0` a minimum and a comparison first).
+    static_assert(std::is_same_v<V, I>);
+    uint32_t outside = 0;
     for (int g = 0; g < kGroups; ++g) {
       V all = (T(e[0]) + o.off[0][g]) | (T(e[1]) + o.off[1][g]) | (T(e[2]) + o.off[2][g]);
-      bits |= lane_bits(__builtin_convertvector(all >= 0, I)) << (g * kLanes);
+      outside |= lane_bits(all) << (g * kLanes);
     }
-    return bits;
+    return ~outside & 0xffffu;
   }
 }
 
