@@ -382,8 +382,9 @@ struct EdgeGrid {
   // The same in a vector (by reference: no wide vector is passed or returned by value in the
   // baseline copy of this file, whose ABI has no 32-byte registers).
   [[gnu::always_inline]] void at(int x, int y, E4& e) const {
-    e = E4{};
-    for (int k = 0; k < 3; ++k) e[k] = origin[k] + step_x[k] * (x - x0) + step_y[k] * (y - y0);
+    int64_t values[3];
+    at(x, y, values);
+    e = E4{values[0], values[1], values[2], 0};
   }
   // The change of the values from one block to the next right.
   [[gnu::always_inline]] void block_step_x(E4& d) const {
