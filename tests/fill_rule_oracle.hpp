@@ -53,4 +53,20 @@ inline bool rule_covers_pixel(const Fx8Triangle& t, int px, int py) {
   return rule_covers(t, int64_t(px) * 256 + 128, int64_t(py) * 256 + 128);
 }
 
+// The covered pixels of [x0, x1) x [y0, y1), an area inside the 8x8 pixels from (x0 & ~3, y0 &
+// ~3), as the masks of those pixels' four 4x4 blocks: 16 bits each (bit 4 row + column), top
+// left, top right, bottom left, bottom right, from the low bits up.
+inline uint64_t rule_block_masks(const Fx8Triangle& t, int x0, int y0, int x1, int y1) {
+  const int bx = x0 & ~3, by = y0 & ~3;
+  uint64_t masks = 0;
+  for (int py = y0; py < y1; ++py) {
+    for (int px = x0; px < x1; ++px) {
+      if (!rule_covers_pixel(t, px, py)) continue;
+      const int block = (py - by) / 4 * 2 + (px - bx) / 4, bit = (py - by) % 4 * 4 + (px - bx) % 4;
+      masks |= uint64_t(1) << (16 * block + bit);
+    }
+  }
+  return masks;
+}
+
 }  // namespace softrast::test

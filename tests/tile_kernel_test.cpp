@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "counting_shader.hpp"
+#include "fill_rule_oracle.hpp"
 #include "pipeline/tile_kernels.hpp"
 #include "raster/raster.hpp"
 #include "softrast/shader.hpp"
@@ -36,13 +37,15 @@ void collect(void* context, int x, int y, uint32_t mask) {
   (*static_cast<Blocks*>(context))[{x, y}] = mask;
 }
 
-// One record in an arena, as the binned draw makes it.
+// One record in an arena, as the binned draw makes it; with `blocks`, a speck's coverage by block
+// as the SIMD setup gives it (TriRecord::blocks).
 struct OneRecord {
   alignas(8) std::byte bytes[detail::record_bytes(0)];
-  explicit OneRecord(const detail::TriangleSetup& tri) {
+  OneRecord(const detail::TriangleSetup& tri, uint64_t blocks) {
     auto* rec = new (bytes) detail::TriRecord;
     for (int k = 0; k < 3; ++k) rec->edge[k] = tri.edge[k];
     rec->bounds = tri.bounds;
+    rec->blocks = blocks;
     auto extent = [](const int32_t v[3]) {
       return int64_t(std::max({v[0], v[1], v[2]})) - std::min({v[0], v[1], v[2]});
     };
@@ -52,16 +55,32 @@ struct OneRecord {
   }
 };
 
+bool agrees(const detail::TriangleSetup& tri, const PixelRect& scissor, uint64_t blocks);
+int specks_checked = 0;  // agrees() calls with a record's blocks
+
 // Compares the kernels of every level with the edge-equation rasterizer on every tile the
-// triangle touches; returns false (with failures recorded) on a difference.
+// triangle touches, from the edges and (bounds of at most 4x4 pixels) from the blocks' masks;
+// returns false (with failures recorded) on a difference.
 bool agrees(const detail::WindowVertex v[3], int width, int height) {
-  PixelRect scissor{0, 0, width, height};
+  const PixelRect scissor{0, 0, width, height};
   detail::TriangleSetup tri;
   if (!detail::setup_triangle(v[0], v[1], v[2], 0, CullMode::kNone, FrontFace::kCounterClockwise,
                               scissor, tri)) {
     return true;
   }
-  OneRecord record(tri);
+  if (!agrees(tri, scissor, 0)) return false;
+  const PixelRect& b = tri.bounds;
+  if (b.x1 - b.x0 > 4 || b.y1 - b.y0 > 4) return true;
+  const test::Fx8Triangle rule{{tri.vx[0], tri.vx[1], tri.vx[2]},
+                               {tri.vy[0], tri.vy[1], tri.vy[2]}};
+  const uint64_t blocks = test::rule_block_masks(rule, b.x0, b.y0, b.x1, b.y1);
+  if (blocks == 0) return true;  // the SIMD setup drops it
+  ++specks_checked;
+  return agrees(tri, scissor, blocks);
+}
+
+bool agrees(const detail::TriangleSetup& tri, const PixelRect& scissor, uint64_t blocks) {
+  OneRecord record(tri, blocks);
   uint32_t offset = 0;
   for (int level = 0; level <= int(cpu_simd_level()); ++level) {
     detail::TileKernels kernels = detail::tile_kernels(SimdLevel(level));
@@ -81,9 +100,10 @@ bool agrees(const detail::WindowVertex v[3], int width, int height) {
         if (got != expected) {
           ADD_FAILURE() << "level " << simd_level_name(SimdLevel(level)) << " tile " << tx << ","
                         << ty << " small "
-                        << reinterpret_cast<detail::TriRecord*>(record.bytes)->small
-                        << " vertices (" << v[0].x << "," << v[0].y << ") (" << v[1].x << ","
-                        << v[1].y << ") (" << v[2].x << "," << v[2].y << ")";
+                        << reinterpret_cast<detail::TriRecord*>(record.bytes)->small << " blocks "
+                        << blocks << " scissor " << scissor.x0 << "," << scissor.y0 << " vertices ("
+                        << tri.vx[0] << "," << tri.vy[0] << ") (" << tri.vx[1] << "," << tri.vy[1]
+                        << ") (" << tri.vx[2] << "," << tri.vy[2] << ")";
           return false;
         }
       }
@@ -105,6 +125,7 @@ TEST(TileKernel, CoverageEqualsTheEdgeEquationRasterizer) {
   // Triangle sizes in 1/256 pixel: inside one block, around the 32-bit bound, large, huge (far
   // outside the image, inside the guard band).
   const int64_t sizes[] = {700,
+                           1000,
                            3000,
                            detail::kSmallTriangleFx8 - 50,
                            detail::kSmallTriangleFx8 + 50,
@@ -126,6 +147,7 @@ TEST(TileKernel, CoverageEqualsTheEdgeEquationRasterizer) {
       ASSERT_TRUE(agrees(v, width, height)) << "size " << size << " triangle " << i;
     }
   }
+  EXPECT_GT(specks_checked, 200);  // the masks of specks, on both sides of tiles' edges
 }
 
 // The resolve kernels' depth is the fragment stage's (shade_block.hpp) to the bit, including

@@ -5,7 +5,7 @@
 // functions with the fill rule, bounds inside the scissor, the 32-bit flag and the signed area,
 // and the plane equations of setup_triangle_interpolants (or, where 1/w needs rescaling, the
 // scalar setup's); except that the kernel drops the tiny triangles that cover no pixel, exactly
-// those.
+// those, and gives the coverage of the others by block (the fill rule's, pixel by pixel).
 // Then whole draws with culling through the binned path at every level against the reference
 // path.
 #include <gtest/gtest.h>
@@ -17,6 +17,7 @@
 #include <random>
 #include <vector>
 
+#include "fill_rule_oracle.hpp"
 #include "pipeline/draw_internal.hpp"
 #include "pipeline/triangle_kernels.hpp"
 #include "softrast/renderer.hpp"
@@ -142,7 +143,7 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
     }
   }
   int checked_ready = 0, checked_scalar = 0, checked_none = 0, checked_dropped = 0,
-      checked_rescaled = 0, checked_on_edge = 0;
+      checked_rescaled = 0, checked_on_edge = 0, checked_blocks = 0;
   int levels = 0;  // levels checked: the counts below are sums over them
   for (SimdLevel level : {SimdLevel::kAvx2, SimdLevel::kAvx512}) {
     if (cpu_simd_level() < level) continue;
@@ -223,13 +224,15 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
                   continue;
                 }
                 // Kept: only triangles that cover a pixel, wherever the test applies.
-                if (want.bounds.x1 - want.bounds.x0 <= 4 && want.bounds.y1 - want.bounds.y0 <= 4 &&
-                    std::max({want.vx[0], want.vx[1], want.vx[2]}) -
-                            std::min({want.vx[0], want.vx[1], want.vx[2]}) <=
-                        6 * detail::kSubpixelOne &&
-                    std::max({want.vy[0], want.vy[1], want.vy[2]}) -
-                            std::min({want.vy[0], want.vy[1], want.vy[2]}) <=
-                        6 * detail::kSubpixelOne) {
+                const bool speck = want.bounds.x1 - want.bounds.x0 <= 4 &&
+                                   want.bounds.y1 - want.bounds.y0 <= 4 &&
+                                   std::max({want.vx[0], want.vx[1], want.vx[2]}) -
+                                           std::min({want.vx[0], want.vx[1], want.vx[2]}) <=
+                                       6 * detail::kSubpixelOne &&
+                                   std::max({want.vy[0], want.vy[1], want.vy[2]}) -
+                                           std::min({want.vy[0], want.vy[1], want.vy[2]}) <=
+                                       6 * detail::kSubpixelOne;
+                if (speck) {
                   ASSERT_TRUE(covers_a_pixel(want));
                 }
                 ++checked_ready;
@@ -247,6 +250,18 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
                 EXPECT_EQ(lanes.bounds[1][l], want.bounds.y0);
                 EXPECT_EQ(lanes.bounds[2][l], want.bounds.x1);
                 EXPECT_EQ(lanes.bounds[3][l], want.bounds.y1);
+                // A speck's coverage by block (the fill rule's, pixel by pixel); none for a
+                // larger triangle.
+                const uint64_t blocks = lanes.blocks[0][l] | uint64_t(lanes.blocks[1][l]) << 32;
+                if (speck) {
+                  const test::Fx8Triangle rule{{want.vx[0], want.vx[1], want.vx[2]},
+                                               {want.vy[0], want.vy[1], want.vy[2]}};
+                  const detail::PixelRect& b = want.bounds;
+                  EXPECT_EQ(blocks, test::rule_block_masks(rule, b.x0, b.y0, b.x1, b.y1));
+                  ++checked_blocks;
+                } else {
+                  EXPECT_EQ(blocks, 0u);
+                }
                 auto extent = [](const int32_t c[3]) {
                   return int64_t(std::max({c[0], c[1], c[2]})) - std::min({c[0], c[1], c[2]});
                 };
@@ -300,6 +315,7 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
   EXPECT_GT(checked_dropped, 500 * levels);
   EXPECT_GT(checked_rescaled, 50 * levels);
   EXPECT_GT(checked_on_edge, 50 * levels);
+  EXPECT_GT(checked_blocks, 1000 * levels);
 }
 
 // Flat-coloured triangles of both facings, some crossing the near plane and the image border,

@@ -223,6 +223,7 @@ class BinnedDraw {
     }
     rec->bounds = {lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l], lanes.bounds[3][l]};
     rec->small = (lanes.small >> l) & 1u;
+    rec->blocks = lanes.blocks[0][l] | uint64_t(lanes.blocks[1][l]) << 32;
     if (scanline_) {
       int32_t* v = rec->vertices(geometry_.num_varyings());
       for (int k = 0; k < 3; ++k) v[k] = lanes.x[k][l], v[3 + k] = lanes.y[k][l];
@@ -282,6 +283,7 @@ class BinnedDraw {
       return int64_t(std::max({v[0], v[1], v[2]})) - std::min({v[0], v[1], v[2]});
     };
     rec->small = extent(t.vx) <= kSmallTriangleFx8 && extent(t.vy) <= kSmallTriangleFx8;
+    rec->blocks = 0;
     if (scanline_) {
       int32_t* v = rec->vertices(geometry_.num_varyings());
       for (int k = 0; k < 3; ++k) v[k] = t.vx[k], v[3 + k] = t.vy[k];

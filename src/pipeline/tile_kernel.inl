@@ -474,11 +474,35 @@ template <Mode kMode, class V, class T>
   }
 }
 
+// A speck whose coverage the SIMD setup computed (TriRecord::blocks): its blocks in this tile, in
+// the order the loops above take them. Its covered pixels lie inside its bounds, so inside the
+// scissor, and a block lies inside one tile: the blocks that overlap `area` (the bounds inside the
+// tile's region) are the tile's, and their masks need no cut by the region.
+template <Mode kMode>
+[[gnu::always_inline]] inline void raster_speck(TileJob& job, const TriRecord& rec, int32_t id,
+                                                const PixelRect& area) {
+  BlockTarget<kMode> emit(job, rec, id, area);
+  const int bx = rec.bounds.x0 & ~(kBlockSize - 1), by = rec.bounds.y0 & ~(kBlockSize - 1);
+  for (uint64_t blocks = rec.blocks; blocks != 0;) {
+    const int i = __builtin_ctzll(blocks) >> 4;
+    const uint32_t bits = uint32_t(blocks >> (16 * i)) & 0xffffu;
+    blocks &= ~(uint64_t(0xffffu) << (16 * i));
+    const int x = bx + kBlockSize * (i & 1), y = by + kBlockSize * (i >> 1);
+    if (x + kBlockSize > area.x0 && x < area.x1 && y + kBlockSize > area.y0 && y < area.y1) {
+      emit(x, y, bits);
+    }
+  }
+}
+
 template <Mode kMode>
 [[gnu::always_inline]] inline void raster_record(TileJob& job, const TriRecord& rec, int32_t id) {
   const TriRecord& t = rec;
   PixelRect area = intersect(t.bounds, job.region);
   if (area.empty()) return;
+  if (rec.blocks != 0) {
+    raster_speck<kMode>(job, rec, id, area);
+    return;
+  }
   EdgeGrid grid;
   grid.x0 = area.x0 & ~(kBlockSize - 1);
   grid.y0 = area.y0 & ~(kBlockSize - 1);

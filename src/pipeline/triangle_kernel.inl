@@ -49,6 +49,17 @@ typedef float F __attribute__((vector_size(4 * kL)));
 #endif
 }
 
+// Four rows of 8 bits (bytes 0 to 3, column c at bit c) as two 4x4 masks (bit 4 row + column):
+// columns 0 to 3 in the low 16 bits, 4 to 7 in the high.
+[[gnu::always_inline]] inline U block_mask(U rows) {
+  rows &= 0x0f0f0f0fu;
+  rows = (rows | rows >> 4) & 0x00ff00ffu;
+  return (rows | rows >> 8) & 0xffffu;
+}
+[[gnu::always_inline]] inline U block_pair(U rows) {
+  return block_mask(rows) | block_mask(rows >> 4) << 16;
+}
+
 [[gnu::always_inline]] inline I min3(I a, I b, I c) {
   I m = a < b ? a : b;
   return m < c ? m : c;
@@ -344,6 +355,8 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
       step_x[k] = (speck & edge_a[k]) * kSubpixelOne;
       step_y[k] = (speck & edge_b[k]) * kSubpixelOne;
     }
+    // The covered samples as bits 8 row + column: the bounds' 4x4 pixels in the first four bits
+    // of four bytes, rows of an 8x8 area of pixels.
     I covered = I{};
     for (int row = 0; row < 4; ++row) {
       I r[3] = {e[0] + step_y[0] * row, e[1] + step_y[1] * row, e[2] + step_y[2] * row};
@@ -351,10 +364,22 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
       for (int column = 0; column < 4; ++column) {
         const I all =
             (r[0] + step_x[0] * column) | (r[1] + step_x[1] * column) | (r[2] + step_x[2] * column);
-        covered |= (all >= 0) & row_ok & (width > column);
+        covered |= (all >= 0) & row_ok & (width > column) & (1 << (8 * row + column));
       }
     }
-    out.ready &= ~lane_bits(speck & ~covered);
+    covered &= speck;
+    out.ready &= ~lane_bits(speck & ~(covered != 0));
+    // The same bits as blocks (TriRecord::blocks): the 8x8 area moved to the first of the 2x2
+    // blocks that hold the bounds (by 8 rows + columns of the bounds' offset in its block), as
+    // two halves of 32 bits, rows 0 to 3 and rows 4 to 7; each half's left and right 4x4 block.
+    const U shift = U((by0 & 3) * 8 + (bx0 & 3));  // at most 27
+    const U upper = U(covered) << shift;
+    const U lower = (U(covered) >> 1) >> (31 - shift);  // what moved past bit 31 (0 if nothing)
+    const U top = block_pair(upper), bottom = block_pair(lower);
+    std::memcpy(out.blocks[0], &top, sizeof top);
+    std::memcpy(out.blocks[1], &bottom, sizeof bottom);
+  } else {
+    std::memset(out.blocks, 0, sizeof out.blocks);
   }
 
   std::memcpy(out.bounds[0], &bx0, sizeof bx0);
