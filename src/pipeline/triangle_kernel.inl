@@ -320,53 +320,60 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
   // c = dy xi - dx yi, one less unless the edge is top or left (is_top_left).
   I edge_a[3], edge_b[3];
   Q edge_c[3];
-  D edge_c_double[3];  // the same integers as doubles (exact), for the test below
+  I bias[3];  // -1 unless the edge is top or left, else 0
   for (int k = 0; k < 3; ++k) {
     const int j = (k + 1) % 3;
     const I dx = vx[j] - vx[k], dy = vy[j] - vy[k];
     edge_a[k] = -dy;
     edge_b[k] = dx;
-    const I top_left = (dy < 0) | ((dy == 0) & (dx > 0));
+    bias[k] = ~((dy < 0) | ((dy == 0) & (dx > 0)));
     const D c = SOFTRAST_TO_DOUBLE(dy) * SOFTRAST_TO_DOUBLE(vx[k]) -
                 SOFTRAST_TO_DOUBLE(dx) * SOFTRAST_TO_DOUBLE(vy[k]);
-    edge_c[k] =
-        SOFTRAST_EXACT_INT64(c) + __builtin_convertvector(~top_left, Q);  // -1: not top-left
-    edge_c_double[k] = c + SOFTRAST_TO_DOUBLE(~top_left);
+    edge_c[k] = SOFTRAST_EXACT_INT64(c) + __builtin_convertvector(bias[k], Q);
   }
 
   // A triangle whose bounds are at most 4x4 pixels and whose edges pass no sample inside them
   // (a sliver or a speck between pixel centres: a sixth of spheres_1m's records) covers no pixel:
   // it is dropped here, before its record, planes and bins are made. Its samples are tested as
   // the tile kernels test them: E = a x + b y + c at the sample, covered when all three are >= 0.
-  // E at the bounds' first sample is exact in double (products of 16.8 coordinates,
-  // fixed_point.hpp). The vertices span at most 6 pixels (1536 in 1/256), so |a|, |b| <= 1536,
-  // and the 16 samples lie within 2304 of every vertex: |E| <= 2 * 1536 * 2304 < 2^23, int32.
+  // Edge k's c is the bias minus a xk + b yk (vertex k's), so E is a (x - xk) + b (y - yk) + bias,
+  // exactly, in int32: the vertices span at most 6 pixels (1536 in 1/256), so |a|, |b| <= 1536,
+  // and the 16 samples lie within 2304 of every vertex: |E| <= 2 * 1536 * 2304 < 2^23.
   const I width = bx1 - bx0, height = by1 - by0;
   const I speck = kept & inside & (width <= 4) & (height <= 4) & (xmax - xmin <= 6 * kSubpixelOne) &
                   (ymax - ymin <= 6 * kSubpixelOne);
   if (lane_bits(speck) != 0) {
-    const D sx = SOFTRAST_TO_DOUBLE(bx0) * double(kSubpixelOne) + double(kSubpixelHalf);
-    const D sy = SOFTRAST_TO_DOUBLE(by0) * double(kSubpixelOne) + double(kSubpixelHalf);
+    // Every value below is 0 in the other lanes (unused; no overflow there).
+    const I sx = (bx0 * kSubpixelOne + kSubpixelHalf) & speck;
+    const I sy = (by0 * kSubpixelOne + kSubpixelHalf) & speck;
     I e[3], step_x[3], step_y[3];
     for (int k = 0; k < 3; ++k) {
-      const D at = SOFTRAST_TO_DOUBLE(edge_a[k]) * sx + SOFTRAST_TO_DOUBLE(edge_b[k]) * sy +
-                   edge_c_double[k];
-      e[k] = speck ? __builtin_convertvector(at, I) : I{};  // other lanes: unused, kept finite
-      step_x[k] = (speck & edge_a[k]) * kSubpixelOne;
-      step_y[k] = (speck & edge_b[k]) * kSubpixelOne;
+      const I a = edge_a[k] & speck, b = edge_b[k] & speck;
+      e[k] = a * (sx - (vx[k] & speck)) + b * (sy - (vy[k] & speck)) + (bias[k] & speck);
+      step_x[k] = a * kSubpixelOne;
+      step_y[k] = b * kSubpixelOne;
     }
-    // The covered samples as bits 8 row + column: the bounds' 4x4 pixels in the first four bits
-    // of four bytes, rows of an 8x8 area of pixels.
-    I covered = I{};
-    for (int row = 0; row < 4; ++row) {
-      I r[3] = {e[0] + step_y[0] * row, e[1] + step_y[1] * row, e[2] + step_y[2] * row};
-      const I row_ok = height > row;
-      for (int column = 0; column < 4; ++column) {
-        const I all =
-            (r[0] + step_x[0] * column) | (r[1] + step_x[1] * column) | (r[2] + step_x[2] * column);
-        covered |= (all >= 0) & row_ok & (width > column) & (1 << (8 * row + column));
+    // The samples outside as bits 8 row + column (the bounds' 4x4 pixels in the first four bits
+    // of four bytes, rows of an 8x8 area of pixels): the sign bits of the or of the three values,
+    // shifted in from the last sample to the first, with four more shifts between rows (the
+    // bits 4 to 7 of each byte). Samples past the bounds are tested too, and cut after.
+    U outside = U{};
+    for (int k = 0; k < 3; ++k) e[k] += 3 * step_x[k] + 3 * step_y[k];  // the last sample
+    for (int row = 3; row >= 0; --row) {
+      I c[3] = {e[0], e[1], e[2]};
+      for (int column = 3; column >= 0; --column) {
+        outside = (outside << 1) | (U(c[0] | c[1] | c[2]) >> 31);
+        for (int k = 0; k < 3; ++k) c[k] -= step_x[k];
       }
+      if (row > 0) outside <<= 4;
+      for (int k = 0; k < 3; ++k) e[k] -= step_y[k];
     }
+    I covered = I(~outside);
+    // The bounds: `width` bits of each of `height` bytes (both 1 to 4 in specks; 4 elsewhere, to
+    // keep the shift counts in range).
+    const U columns = (U{} + 0xffu) >> U(8 - (speck ? width : 4));
+    const U rows = (U{} + 0xffffffffu) >> U(32 - 8 * (speck ? height : 4));
+    covered &= I((columns | columns << 8 | columns << 16 | columns << 24) & rows);
     covered &= speck;
     out.ready &= ~lane_bits(speck & ~(covered != 0));
     // The same bits as blocks (TriRecord::blocks): the 8x8 area moved to the first of the 2x2
