@@ -75,12 +75,23 @@ typedef float F __attribute__((vector_size(4 * kL)));
 // integer is the low bits of the sum's mantissa.
 #define SOFTRAST_EXACT_INT64(v) (Q((v) + (D{} + 0x1.8p52)) - Q(D{} + 0x1.8p52))
 
+// A vector to an aligned row of kL floats.
+[[gnu::always_inline]] inline void store_row(float* row, F v) {
+#if SOFTRAST_TRIANGLE_LANES == 16
+  _mm512_store_ps(row, __m512(v));
+#else
+  _mm256_store_ps(row, __m256(v));
+#endif
+}
+
 // Four consecutive floats of every lane, from base + index[l] * stride (the first `count` of
 // them; the others 0, not read), as four vectors: out[f] lane l = base[index[l] * stride + f].
 // One 128-bit load per lane, then a 4x4 transpose within each 128-bit part: part c of the vector
-// m holds lane 4c + m.
+// m holds lane 4c + m. The first `count` also stored, to rows[f] (each vector from its register:
+// copied through the stack, they had cost a third of the loads).
 [[gnu::always_inline]] inline void load_quads(const float* base, const uint32_t* index,
-                                              size_t stride, int count, F (&out)[4]) {
+                                              size_t stride, int count, F (&out)[4],
+                                              float (*rows)[kL]) {
   auto at = [&](int l) { return base + size_t(index[l]) * stride; };
 #if SOFTRAST_TRIANGLE_LANES == 16
   const __mmask8 mask = __mmask8((1u << count) - 1);
@@ -114,6 +125,9 @@ typedef float F __attribute__((vector_size(4 * kL)));
   out[2] = F(_mm256_castpd_ps(_mm256_unpacklo_pd(t1, t3)));
   out[3] = F(_mm256_castpd_ps(_mm256_unpackhi_pd(t1, t3)));
 #endif
+  for (int f = 0; f < 4; ++f) {
+    if (f < count) store_row(rows[f], out[f]);
+  }
 }
 
 // setup_planes (raster/setup.cpp) for every lane: the same double operations in the same order,
@@ -169,8 +183,7 @@ template <class T, class V>
   for (int k = 0; k < 3; ++k) {
     static_assert(sizeof(PackedVertex) == 6 * sizeof(float) && offsetof(PackedVertex, z) == 8);
     F q[4];
-    load_quads(&b.window->z, out.vertex[k], 6, 4, q);
-    for (int f = 0; f < 4; ++f) std::memcpy(vertex_floats[k][f], &q[f], sizeof q[f]);
+    load_quads(&b.window->z, out.vertex[k], 6, 4, q, vertex_floats[k]);
     largest = k == 0 ? q[1] : (largest < q[1] ? q[1] : largest);
   }
   out.scalar_planes = out.ready & lane_bits(~((largest <= 0x1p20f) & (largest >= 0x1p-20f)));
@@ -180,8 +193,7 @@ template <class T, class V>
     const int count = std::min(4, b.num_varyings - first);
     for (int k = 0; k < 3; ++k) {
       F q[4];
-      load_quads(b.varyings + first, out.vertex[k], b.stride, count, q);
-      for (int f = 0; f < count; ++f) std::memcpy(var_floats[k][first + f], &q[f], sizeof q[f]);
+      load_quads(b.varyings + first, out.vertex[k], b.stride, count, q, var_floats[k] + first);
     }
   }
   for (int h = 0; h < 2; ++h) {
