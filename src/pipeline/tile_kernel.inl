@@ -494,13 +494,25 @@ template <Mode kMode>
   }
 }
 
+// The same out of line, for the deferred modes: inline, it cost the partial blocks of large
+// triangles registers (overdraw gouraud: the depth resolve 870.3 M -> 885.1 M instructions).
+template <Mode kMode>
+[[gnu::noinline]] void raster_speck_out_of_line(TileJob& job, const TriRecord& rec, int32_t id,
+                                                const PixelRect& area) {
+  raster_speck<kMode>(job, rec, id, area);
+}
+
 template <Mode kMode>
 [[gnu::always_inline]] inline void raster_record(TileJob& job, const TriRecord& rec, int32_t id) {
   const TriRecord& t = rec;
   PixelRect area = intersect(t.bounds, job.region);
   if (area.empty()) return;
   if (rec.blocks != 0) {
-    raster_speck<kMode>(job, rec, id, area);
+    if constexpr (kMode == Mode::kImmediate) {
+      raster_speck<kMode>(job, rec, id, area);
+    } else {
+      raster_speck_out_of_line<kMode>(job, rec, id, area);
+    }
     return;
   }
   EdgeGrid grid;
