@@ -348,9 +348,10 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
   // (a sliver or a speck between pixel centres: a sixth of spheres_1m's records) covers no pixel:
   // it is dropped here, before its record, planes and bins are made. Its samples are tested as
   // the tile kernels test them: E = a x + b y + c at the sample, covered when all three are >= 0.
-  // Edge k's c is the bias minus a xk + b yk (vertex k's), so E is a (x - xk) + b (y - yk) + bias,
-  // exactly, in int32: the vertices span at most 6 pixels (1536 in 1/256), so |a|, |b| <= 1536,
-  // and the 16 samples lie within 2304 of every vertex: |E| <= 2 * 1536 * 2304 < 2^23.
+  // Edge k's c is bias - (a xk + b yk), with vertex k's xk and yk, so E is
+  // a (x - xk) + b (y - yk) + bias, exactly, in int32: the vertices span at most 6 pixels (1536
+  // in 1/256), so |a|, |b| <= 1536, and the 16 samples lie within 2304 of every vertex:
+  // |E| <= 2 * 1536 * 2304 < 2^23.
   const I width = bx1 - bx0, height = by1 - by0;
   const I speck = kept & inside & (width <= 4) & (height <= 4) & (xmax - xmin <= 6 * kSubpixelOne) &
                   (ymax - ymin <= 6 * kSubpixelOne);
