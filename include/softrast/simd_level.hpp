@@ -28,7 +28,7 @@ void set_simd_level(SimdLevel cap);
 // images do not depend on it; the speed does, and which is faster depends on the CPU (Intel's
 // microcode against Gather Data Sampling, "Downfall", 2023, made the instruction several times
 // slower on the cores from Skylake to Tiger Lake). By default the first draw times both on a
-// small table, per vector width, and keeps the faster one (the instruction unless loads are
+// small table, per vector width, and keeps the faster one (loads unless the instruction is
 // clearly faster). SOFTRAST_GATHER=instruction|loads or set_gather_mode() fixes the choice. SSE2
 // and SSE4.2, which have no gather instruction, always load per lane.
 enum class GatherMode { kInstruction, kLoads };
