@@ -111,8 +111,9 @@ bool alternative_is_faster(Time time) {
 
 // Whether gathers are to be loads: unless the instruction is clearly faster. (It was the other
 // way round, the instruction unless loads were clearly faster, until an AMD Zen 3 showed loads
-// 5 to 39 % faster in this timing, under the fifth, and faster in every draw of quad_grid
-// texture too: 8.3 against 9.0 ms at two threads, 14.7 against 16.0 at one.)
+// 5 to 39 % faster in this timing, mostly under the fifth, so that the instruction was kept in 7
+// of 10 starts; yet loads were faster in every draw of quad_grid texture: 8.3 against 9.0 ms at
+// two threads, 14.7 against 16.0 at one.)
 template <class Time>
 bool gathers_by_loads(Time time) {
   std::vector<int32_t> table(kTableSize + 1);  // + 1: the last lane's pair may start at the end
