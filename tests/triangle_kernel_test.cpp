@@ -12,13 +12,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "fill_rule_oracle.hpp"
 #include "pipeline/draw_internal.hpp"
+#include "pipeline/record_transpose.hpp"
 #include "pipeline/triangle_kernels.hpp"
 #include "softrast/renderer.hpp"
 #include "softrast/shader.hpp"
@@ -316,6 +320,68 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
   EXPECT_GT(checked_rescaled, 50 * levels);
   EXPECT_GT(checked_on_edge, 50 * levels);
   EXPECT_GT(checked_blocks, 1000 * levels);
+}
+
+// write_records against the field-by-field writers, for lanes of random bits (every field's
+// value range, negative and zero areas, both signs of the 32-bit edge coefficients), every number
+// of varyings it takes, both windings as front and both group widths: the same bytes in every
+// field of every ready lane, zeros in the padding, and not a byte written past a record.
+TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
+  if (cpu_simd_level() < SimdLevel::kAvx2) GTEST_SKIP() << "no AVX2 on this CPU";
+  std::mt19937 rng(29);
+  auto fill = [&](void* p, size_t bytes) {
+    auto* b = static_cast<unsigned char*>(p);
+    for (size_t i = 0; i < bytes; ++i) b[i] = static_cast<unsigned char>(rng());
+  };
+  constexpr int kLanes = detail::TriangleLanes::kMaxLanes;
+  constexpr size_t kRoom = sizeof(detail::TriRecord) + sizeof(detail::Interpolants) + 64;
+  constexpr unsigned char kGuard = 0xa5;
+  int compared = 0, front = 0, back = 0;
+  for (int round = 0; round < 40; ++round) {
+    auto lanes = std::make_unique<detail::TriangleLanes>();
+    fill(lanes.get(), sizeof(detail::TriangleLanes));
+    for (int l = 0; l < kLanes; ++l) {
+      if (l % 5 == round % 5) lanes->area[l] = 0;
+      if (l % 7 == round % 7) lanes->area[l] = -int64_t(rng() % 1000) - 1;
+      if (l % 3 == round % 3) lanes->area[l] = int64_t(rng() % 1000) + 1;
+    }
+    lanes->ready = uint32_t(rng()) | 1u;
+    lanes->scalar_planes = 0;
+    for (int count : {8, 16}) {
+      for (int num_varyings = 0; num_varyings <= detail::kMaxTransposedVaryings; ++num_varyings) {
+        const size_t bytes = detail::record_bytes(num_varyings);
+        for (FrontFace face : {FrontFace::kCounterClockwise, FrontFace::kClockwise}) {
+          // Each lane's record at its own place, unaligned for odd lanes, guard bytes after it.
+          std::vector<std::vector<unsigned char>> room(kLanes, std::vector<unsigned char>(kRoom));
+          std::byte* dest[kLanes];
+          for (int l = 0; l < kLanes; ++l) {
+            std::fill(room[l].begin(), room[l].end(), kGuard);
+            dest[l] = reinterpret_cast<std::byte*>(room[l].data() + 8 * (l % 2));
+          }
+          detail::write_records(*lanes, count, num_varyings, face, dest, bytes);
+          for (int l = 0; l < count; ++l) {
+            if (!((lanes->ready >> l) & 1u)) continue;
+            SCOPED_TRACE(::testing::Message() << "lane " << l << " of " << count << ", "
+                                              << num_varyings << " varyings, face " << int(face));
+            alignas(64) unsigned char expected[kRoom] = {};
+            auto* rec = reinterpret_cast<detail::TriRecord*>(expected);
+            detail::write_coverage(*lanes, l, rec);
+            detail::write_planes(*lanes, l, num_varyings, face, rec->interp());
+            (rec->interp().front_facing ? front : back) += 1;
+            // The padding bytes of `expected` are zeros: its fields were written into zeros.
+            ASSERT_EQ(std::memcmp(expected, dest[l], bytes), 0);
+            const unsigned char* after = reinterpret_cast<unsigned char*>(dest[l]) + bytes;
+            const unsigned char* end = room[l].data() + kRoom;
+            ASSERT_TRUE(std::all_of(after, end, [](unsigned char c) { return c == kGuard; }));
+            ++compared;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 3000);
+  EXPECT_GT(front, 500);
+  EXPECT_GT(back, 500);
 }
 
 // Flat-coloured triangles of both facings, some crossing the near plane and the image border,

@@ -32,6 +32,7 @@
 
 #include "core/prefetch.hpp"
 #include "pipeline/draw_internal.hpp"
+#include "pipeline/record_transpose.hpp"
 #include "pipeline/tile_kernels.hpp"
 #include "pipeline/tile_visibility.hpp"
 #include "pipeline/triangle_kernels.hpp"
@@ -198,8 +199,18 @@ class BinnedDraw {
       batch.num_varyings = geometry_.num_varyings();
       TriangleLanes lanes;
       const size_t width = size_t(triangle_kernel_.lanes);
+      // Groups of set-up triangles only, at least three of them, take write_records
+      // (record_transpose.hpp; below three, field by field was fewer instructions), where the
+      // records hold no vertices and at most kMaxTransposedVaryings varyings.
+      const bool transposed = !scanline_ && batch.num_varyings <= kMaxTransposedVaryings;
+      alignas(32) std::byte scratch[kMaxTransposedBytes];
       for (size_t t = begin; t < end; t += width) {
         triangle_kernel_.fn(batch, t, int(std::min(width, end - t)), lanes);
+        const uint32_t ready = lanes.ready, two = ready & (ready - 1);
+        if (transposed && (lanes.scalar | lanes.scalar_planes) == 0 && (two & (two - 1)) != 0) {
+          add_group(chunk, lanes, int(width), scratch);
+          continue;
+        }
         for (uint32_t todo = lanes.ready | lanes.scalar; todo != 0; todo &= todo - 1) {
           int l = __builtin_ctz(todo);
           if ((lanes.scalar >> l) & 1u) {
@@ -214,16 +225,31 @@ class BinnedDraw {
     for (size_t t = begin; t < end; ++t) vertices.triangle(geometry_, indices + 3 * t, keep, add);
   }
 
+  // The records of a group whose ready lanes are all set up by the kernel, planes included, in
+  // one stretch of the arena, in lane order; then their places in the bins.
+  void add_group(Chunk& chunk, const TriangleLanes& lanes, int width, std::byte* scratch) {
+    int count = 0;
+    for (uint32_t m = lanes.ready; m != 0; m &= m - 1) ++count;
+    const uint32_t first = chunk.records.allocate(size_t(count) * record_bytes_);
+    std::byte* const data = reinterpret_cast<std::byte*>(chunk.records.at(first));
+    std::byte* dest[TriangleLanes::kMaxLanes];
+    for (int l = 0; l < width; ++l) dest[l] = scratch;
+    uint32_t offset = first;
+    for (uint32_t todo = lanes.ready; todo != 0; todo &= todo - 1) {
+      const int l = __builtin_ctz(todo);
+      dest[l] = data + (offset - first);
+      bin(chunk, {lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l], lanes.bounds[3][l]},
+          offset);
+      offset += uint32_t(record_bytes_);
+    }
+    write_records(lanes, width, geometry_.num_varyings(), state_.front_face, dest, record_bytes_);
+  }
+
   // A triangle that the SIMD kernel set up (lane l): its record, as add_triangle makes it.
   void add_set_up(Chunk& chunk, const TriangleLanes& lanes, int l) {
     uint32_t offset = chunk.records.allocate(record_bytes_);
     TriRecord* rec = chunk.records.at(offset);  // every field is written below
-    for (int k = 0; k < 3; ++k) {
-      rec->edge[k] = {lanes.edge_a[k][l], lanes.edge_b[k][l], lanes.edge_c[k][l]};
-    }
-    rec->bounds = {lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l], lanes.bounds[3][l]};
-    rec->small = (lanes.small >> l) & 1u;
-    rec->blocks = lanes.blocks[0][l] | uint64_t(lanes.blocks[1][l]) << 32;
+    write_coverage(lanes, l, rec);
     if (scanline_) {
       int32_t* v = rec->vertices(geometry_.num_varyings());
       for (int k = 0; k < 3; ++k) v[k] = lanes.x[k][l], v[3 + k] = lanes.y[k][l];
@@ -235,17 +261,7 @@ class BinnedDraw {
       finish_record(chunk, offset, ordered, lanes.area[l]);
       return;
     }
-    // The kernel's planes (the same bits as setup_triangle_interpolants').
-    Interpolants& in = rec->interp();
-    in.x_ref = lanes.x_ref[l];
-    in.y_ref = lanes.y_ref[l];
-    in.z = {lanes.z[0][l], lanes.z[1][l], lanes.z[2][l]};
-    in.inv_w = {lanes.inv_w[0][l], lanes.inv_w[1][l], lanes.inv_w[2][l]};
-    in.num_varyings = geometry_.num_varyings();
-    in.front_facing = is_front_facing(lanes.area[l], state_.front_face);
-    for (int i = 0; i < in.num_varyings; ++i) {
-      in.var[i] = {lanes.var[i][0][l], lanes.var[i][1][l], lanes.var[i][2][l]};
-    }
+    write_planes(lanes, l, geometry_.num_varyings(), state_.front_face, rec->interp());
     bin(chunk, rec->bounds, offset);
   }
 

@@ -1,0 +1,161 @@
+// pipeline/record_transpose.cpp: write_records in AVX2, eight lanes at a time (a 16-lane group of
+// the AVX-512 kernel as two halves).
+#include "pipeline/record_transpose.hpp"
+
+#include "core/isa_target.hpp"
+
+#include <immintrin.h>
+
+#include <cstddef>
+
+namespace softrast::detail {
+
+// The records' 32-bit words, as the rows below make them.
+static_assert(offsetof(TriRecord, edge) == 0 && sizeof(EdgeFunction) == 24);
+static_assert(offsetof(TriRecord, bounds) == 72 && sizeof(PixelRect) == 16);
+static_assert(offsetof(TriRecord, blocks) == 88 && offsetof(TriRecord, small) == 96);
+static_assert(sizeof(TriRecord) == 104);
+static_assert(offsetof(Interpolants, x_ref) == 0 && offsetof(Interpolants, y_ref) == 4);
+static_assert(offsetof(Interpolants, z) == 8 && offsetof(Interpolants, inv_w) == 32);
+static_assert(offsetof(Interpolants, num_varyings) == 44);
+static_assert(offsetof(Interpolants, front_facing) == 48 && offsetof(Interpolants, var) == 52);
+static_assert(sizeof(Plane) == 12 && sizeof(DepthPlane) == 24 && sizeof(bool) == 1);
+
+SOFTRAST_TARGET_BEGIN_AVX2
+namespace {
+
+// Lanes [0, 8) of an array of 32-bit fields.
+[[gnu::always_inline]] inline __m256i row(const void* p) {
+  return _mm256_load_si256(static_cast<const __m256i*>(p));
+}
+
+// The low and high words of lanes [0, 8) of an array of 64-bit fields.
+[[gnu::always_inline]] inline void word_rows(const void* p, __m256i& low, __m256i& high) {
+  const __m256 a = _mm256_load_ps(static_cast<const float*>(p));      // lanes 0-3
+  const __m256 b = _mm256_load_ps(static_cast<const float*>(p) + 8);  // lanes 4-7
+  // Per 128-bit half, the even (odd) words of a then b: lanes 0 1 4 5 | 2 3 6 7.
+  low = _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, 0x88)), 0xd8);
+  high = _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, 0xdd)), 0xd8);
+}
+
+// Rows [0, 8) (row j: word j of lanes 0-7) transposed: lane l's words [8 block, 8 block + 8) to
+// dest[l] + 32 block, the words below `words` of them (a masked store for the record's last
+// block). `whole`: the caller knows that the record has all eight.
+template <bool whole = false>
+[[gnu::always_inline]] inline void transpose_store(const __m256i* r, std::byte* const* dest,
+                                                   int block, int words) {
+  const int left = whole ? 8 : words - 8 * block;
+  if (left <= 0) return;
+  const __m256i t0 = _mm256_unpacklo_epi32(r[0], r[1]), t1 = _mm256_unpackhi_epi32(r[0], r[1]);
+  const __m256i t2 = _mm256_unpacklo_epi32(r[2], r[3]), t3 = _mm256_unpackhi_epi32(r[2], r[3]);
+  const __m256i t4 = _mm256_unpacklo_epi32(r[4], r[5]), t5 = _mm256_unpackhi_epi32(r[4], r[5]);
+  const __m256i t6 = _mm256_unpacklo_epi32(r[6], r[7]), t7 = _mm256_unpackhi_epi32(r[6], r[7]);
+  // u[l]: words 0-3 (low half) or 4-7 (high half) of lanes l and l + 4.
+  const __m256i u[8] = {
+      _mm256_unpacklo_epi64(t0, t2), _mm256_unpackhi_epi64(t0, t2), _mm256_unpacklo_epi64(t1, t3),
+      _mm256_unpackhi_epi64(t1, t3), _mm256_unpacklo_epi64(t4, t6), _mm256_unpackhi_epi64(t4, t6),
+      _mm256_unpacklo_epi64(t5, t7), _mm256_unpackhi_epi64(t5, t7),
+  };
+  auto at = [&](int l) { return reinterpret_cast<__m256i*>(dest[l] + 32 * block); };
+  if (left >= 8) {
+    for (int l = 0; l < 4; ++l) {
+      _mm256_storeu_si256(at(l), _mm256_permute2x128_si256(u[l], u[4 + l], 0x20));
+      _mm256_storeu_si256(at(l + 4), _mm256_permute2x128_si256(u[l], u[4 + l], 0x31));
+    }
+    return;
+  }
+  const __m256i mask =
+      _mm256_cmpgt_epi32(_mm256_set1_epi32(left), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  for (int l = 0; l < 4; ++l) {
+    _mm256_maskstore_epi32(reinterpret_cast<int*>(at(l)), mask,
+                           _mm256_permute2x128_si256(u[l], u[4 + l], 0x20));
+    _mm256_maskstore_epi32(reinterpret_cast<int*>(at(l + 4)), mask,
+                           _mm256_permute2x128_si256(u[l], u[4 + l], 0x31));
+  }
+}
+
+// Lanes [h, h + 8) of the group, the rows of each block of eight words made just before it is
+// stored.
+[[gnu::always_inline]] inline void records8(const TriangleLanes& lanes, int h, int num_varyings,
+                                            FrontFace front_face, std::byte* const* dest,
+                                            int words) {
+  static_assert(record_bytes(0) >= 40 * 4, "the first five blocks are whole in every record");
+  __m256i r[8];
+  // Words 0-23: the edges, the bounds, the blocks.
+  r[0] = row(&lanes.edge_a[0][h]);  // EdgeFunction: a and b sign-extended from 32 bits, c
+  r[1] = _mm256_srai_epi32(r[0], 31);
+  r[2] = row(&lanes.edge_b[0][h]);
+  r[3] = _mm256_srai_epi32(r[2], 31);
+  word_rows(&lanes.edge_c[0][h], r[4], r[5]);
+  r[6] = row(&lanes.edge_a[1][h]);
+  r[7] = _mm256_srai_epi32(r[6], 31);
+  transpose_store<true>(r, dest, 0, words);
+  r[0] = row(&lanes.edge_b[1][h]);
+  r[1] = _mm256_srai_epi32(r[0], 31);
+  word_rows(&lanes.edge_c[1][h], r[2], r[3]);
+  r[4] = row(&lanes.edge_a[2][h]);
+  r[5] = _mm256_srai_epi32(r[4], 31);
+  r[6] = row(&lanes.edge_b[2][h]);
+  r[7] = _mm256_srai_epi32(r[6], 31);
+  transpose_store<true>(r, dest, 1, words);
+  word_rows(&lanes.edge_c[2][h], r[0], r[1]);
+  for (int i = 0; i < 4; ++i) r[2 + i] = row(&lanes.bounds[i][h]);
+  r[6] = row(&lanes.blocks[0][h]);
+  r[7] = row(&lanes.blocks[1][h]);
+  transpose_store<true>(r, dest, 2, words);
+  // Words 24-31: small (a bool, then the record's padding), the interpolants from x_ref.
+  const __m256i one = _mm256_set1_epi32(1);
+  r[0] = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(lanes.small >> h)),
+                                            _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)),
+                          one);
+  r[1] = _mm256_setzero_si256();
+  r[2] = row(&lanes.x_ref[h]);
+  r[3] = row(&lanes.y_ref[h]);
+  word_rows(&lanes.z[0][h], r[4], r[5]);
+  word_rows(&lanes.z[1][h], r[6], r[7]);
+  transpose_store<true>(r, dest, 3, words);
+  // Words 32-39: the rest of the fixed fields, the first varying's a0.
+  word_rows(&lanes.z[2][h], r[0], r[1]);
+  for (int k = 0; k < 3; ++k) r[2 + k] = row(&lanes.inv_w[k][h]);
+  r[5] = _mm256_set1_epi32(num_varyings);
+  {  // front_facing (is_front_facing): area < 0 counter-clockwise, area > 0 clockwise.
+    const __m256i zero = _mm256_setzero_si256();
+    const __m256i a = _mm256_load_si256(reinterpret_cast<const __m256i*>(&lanes.area[h]));
+    const __m256i b = _mm256_load_si256(reinterpret_cast<const __m256i*>(&lanes.area[h + 4]));
+    const bool ccw = front_face == FrontFace::kCounterClockwise;
+    const __m256i fa = ccw ? _mm256_cmpgt_epi64(zero, a) : _mm256_cmpgt_epi64(a, zero);
+    const __m256i fb = ccw ? _mm256_cmpgt_epi64(zero, b) : _mm256_cmpgt_epi64(b, zero);
+    const __m256 words_ab =
+        _mm256_shuffle_ps(_mm256_castsi256_ps(fa), _mm256_castsi256_ps(fb), 0x88);
+    r[6] = _mm256_and_si256(_mm256_permute4x64_epi64(_mm256_castps_si256(words_ab), 0xd8), one);
+  }
+  // Words from 39: the varyings' planes, a0, dadx, dady each (var[i][k] is plane 3 i + k).
+  const float* planes = &lanes.var[0][0][h];
+  const int count = 3 * num_varyings;
+  r[7] = count > 0 ? row(planes) : _mm256_setzero_si256();
+  transpose_store<true>(r, dest, 4, words);
+  for (int first = 1, block = 5; first < count; first += 8, ++block) {
+    if (first + 8 <= count) {
+      for (int i = 0; i < 8; ++i) r[i] = row(planes + (first + i) * TriangleLanes::kMaxLanes);
+    } else {
+      for (int i = 0; i < 8; ++i) {
+        r[i] = first + i < count ? row(planes + (first + i) * TriangleLanes::kMaxLanes)
+                                 : _mm256_setzero_si256();
+      }
+    }
+    transpose_store(r, dest, block, words);
+  }
+}
+
+}  // namespace
+
+void write_records(const TriangleLanes& lanes, int count, int num_varyings, FrontFace front_face,
+                   std::byte* const* dest, size_t bytes) {
+  for (int h = 0; h < count; h += 8) {
+    records8(lanes, h, num_varyings, front_face, dest + h, int(bytes / 4));
+  }
+}
+
+SOFTRAST_TARGET_END
+
+}  // namespace softrast::detail
