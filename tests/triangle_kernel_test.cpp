@@ -336,10 +336,19 @@ TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
   constexpr int kLanes = detail::TriangleLanes::kMaxLanes;
   constexpr size_t kRoom = sizeof(detail::TriRecord) + sizeof(detail::Interpolants) + 64;
   constexpr unsigned char kGuard = 0xa5;
-  int compared = 0, front = 0, back = 0;
+  int compared = 0, front = 0, back = 0, binned = 0, spanning = 0;
   for (int round = 0; round < 40; ++round) {
     auto lanes = std::make_unique<detail::TriangleLanes>();
     fill(lanes.get(), sizeof(detail::TriangleLanes));
+    // Bounds as set-up triangles have them (inside an image of up to 4096 pixels a side), some
+    // inside one tile, some across tiles.
+    for (int l = 0; l < kLanes; ++l) {
+      const int x0 = int(rng() % 4000), y0 = int(rng() % 4000);
+      const int w = l % 2 == 0 ? 1 + int(rng() % 6) : 1 + int(rng() % 200);
+      const int h = l % 3 == 0 ? 1 + int(rng() % 6) : 1 + int(rng() % 200);
+      lanes->bounds[0][l] = x0, lanes->bounds[1][l] = y0;
+      lanes->bounds[2][l] = x0 + w, lanes->bounds[3][l] = y0 + h;
+    }
     for (int l = 0; l < kLanes; ++l) {
       if (l % 5 == round % 5) lanes->area[l] = 0;
       if (l % 7 == round % 7) lanes->area[l] = -int64_t(rng() % 1000) - 1;
@@ -358,7 +367,9 @@ TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
             std::fill(room[l].begin(), room[l].end(), kGuard);
             dest[l] = reinterpret_cast<std::byte*>(room[l].data() + 8 * (l % 2));
           }
-          detail::write_records(*lanes, count, num_varyings, face, dest, bytes);
+          detail::GroupTiles tiles;
+          const int tiles_x = 1 + round % 31;
+          detail::write_records(*lanes, count, num_varyings, face, dest, bytes, tiles_x, tiles);
           for (int l = 0; l < count; ++l) {
             if (!((lanes->ready >> l) & 1u)) continue;
             SCOPED_TRACE(::testing::Message() << "lane " << l << " of " << count << ", "
@@ -370,6 +381,17 @@ TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
             (rec->interp().front_facing ? front : back) += 1;
             // The padding bytes of `expected` are zeros: its fields were written into zeros.
             ASSERT_EQ(std::memcmp(expected, dest[l], bytes), 0);
+            // The bins: the tile of the top-left pixel, and whether the bounds leave it (bounds of
+            // ready lanes lie inside the image: no negative coordinate).
+            const detail::PixelRect& b = rec->bounds;
+            const int t = detail::kTileSize;
+            if (b.x0 >= 0 && b.y0 >= 0 && b.x1 > b.x0 && b.y1 > b.y0) {
+              EXPECT_EQ(tiles.tile[l], uint32_t(b.y0 / t * tiles_x + b.x0 / t));
+              EXPECT_EQ((tiles.spans >> l) & 1u,
+                        uint32_t(b.x0 / t != (b.x1 - 1) / t || b.y0 / t != (b.y1 - 1) / t));
+              ++binned;
+              spanning += (tiles.spans >> l) & 1u;
+            }
             const unsigned char* after = reinterpret_cast<unsigned char*>(dest[l]) + bytes;
             const unsigned char* end = room[l].data() + kRoom;
             ASSERT_TRUE(std::all_of(after, end, [](unsigned char c) { return c == kGuard; }));
@@ -380,6 +402,9 @@ TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
     }
   }
   EXPECT_GT(compared, 3000);
+  EXPECT_EQ(binned, compared);
+  EXPECT_GT(spanning, 500);
+  EXPECT_GT(binned - spanning, 500);
   EXPECT_GT(front, 500);
   EXPECT_GT(back, 500);
 }

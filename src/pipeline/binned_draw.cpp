@@ -234,15 +234,31 @@ class BinnedDraw {
     std::byte* const data = reinterpret_cast<std::byte*>(chunk.records.at(first));
     std::byte* dest[TriangleLanes::kMaxLanes];
     for (int l = 0; l < width; ++l) dest[l] = scratch;
+    std::byte* to = data;
+    for (uint32_t todo = lanes.ready; todo != 0; todo &= todo - 1) {
+      dest[__builtin_ctz(todo)] = to;
+      to += record_bytes_;
+    }
+    GroupTiles tiles;
+    write_records(lanes, width, geometry_.num_varyings(), state_.front_face, dest, record_bytes_,
+                  tiles_x_, tiles);
     uint32_t offset = first;
+    const bool box_area = !chunk.box_area.empty();
     for (uint32_t todo = lanes.ready; todo != 0; todo &= todo - 1) {
       const int l = __builtin_ctz(todo);
-      dest[l] = data + (offset - first);
-      bin(chunk, {lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l], lanes.bounds[3][l]},
-          offset);
+      auto bounds = [&] {
+        return PixelRect{lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l],
+                         lanes.bounds[3][l]};
+      };
+      if ((tiles.spans >> l) & 1u) {
+        bin(chunk, bounds(), offset);
+      } else if (box_area) {
+        bin_in_tile(chunk, tiles.tile[l], bounds(), offset);
+      } else {
+        chunk.bins[tiles.tile[l]].push_back(offset);
+      }
       offset += uint32_t(record_bytes_);
     }
-    write_records(lanes, width, geometry_.num_varyings(), state_.front_face, dest, record_bytes_);
   }
 
   // A triangle that the SIMD kernel set up (lane l): its record, as add_triangle makes it.
@@ -317,7 +333,11 @@ class BinnedDraw {
       bin_tiles(chunk, bounds, offset, tx0, ty0, tx1, ty1);
       return;
     }
-    size_t tile = size_t(ty0) * tiles_x_ + tx0;
+    bin_in_tile(chunk, size_t(ty0) * tiles_x_ + tx0, bounds, offset);
+  }
+
+  // bin() for a triangle whose bounds lie in one tile.
+  void bin_in_tile(Chunk& chunk, size_t tile, const PixelRect& bounds, uint32_t offset) {
     chunk.bins[tile].push_back(offset);
     if (!chunk.box_area.empty()) {
       chunk.box_area[tile] += int64_t(bounds.x1 - bounds.x0) * (bounds.y1 - bounds.y0);

@@ -77,8 +77,8 @@ template <bool whole = false>
 // Lanes [h, h + 8) of the group, the rows of each block of eight words made just before it is
 // stored.
 [[gnu::always_inline]] inline void records8(const TriangleLanes& lanes, int h, int num_varyings,
-                                            FrontFace front_face, std::byte* const* dest,
-                                            int words) {
+                                            FrontFace front_face, std::byte* const* dest, int words,
+                                            int tiles_x, GroupTiles& tiles) {
   static_assert(record_bytes(0) >= 40 * 4, "the first five blocks are whole in every record");
   __m256i r[8];
   // Words 0-23: the edges, the bounds, the blocks.
@@ -103,6 +103,18 @@ template <bool whole = false>
   r[6] = row(&lanes.blocks[0][h]);
   r[7] = row(&lanes.blocks[1][h]);
   transpose_store<true>(r, dest, 2, words);
+  {  // The bins (GroupTiles), from the bounds x0, y0, x1, y1 in r[2..6).
+    static_assert(kTileSize == 1 << 6);
+    const __m256i one = _mm256_set1_epi32(1);
+    const __m256i tx0 = _mm256_srli_epi32(r[2], 6), ty0 = _mm256_srli_epi32(r[3], 6);
+    const __m256i tx1 = _mm256_srli_epi32(_mm256_sub_epi32(r[4], one), 6);
+    const __m256i ty1 = _mm256_srli_epi32(_mm256_sub_epi32(r[5], one), 6);
+    const __m256i one_tile =
+        _mm256_and_si256(_mm256_cmpeq_epi32(tx0, tx1), _mm256_cmpeq_epi32(ty0, ty1));
+    tiles.spans |= (~uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(one_tile))) & 0xffu) << h;
+    _mm256_store_si256(reinterpret_cast<__m256i*>(&tiles.tile[h]),
+                       _mm256_add_epi32(_mm256_mullo_epi32(ty0, _mm256_set1_epi32(tiles_x)), tx0));
+  }
   // Words 24-31: small (a bool, then the record's padding), the interpolants from x_ref.
   const __m256i one = _mm256_set1_epi32(1);
   r[0] = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(lanes.small >> h)),
@@ -150,9 +162,10 @@ template <bool whole = false>
 }  // namespace
 
 void write_records(const TriangleLanes& lanes, int count, int num_varyings, FrontFace front_face,
-                   std::byte* const* dest, size_t bytes) {
+                   std::byte* const* dest, size_t bytes, int tiles_x, GroupTiles& tiles) {
+  tiles.spans = 0;
   for (int h = 0; h < count; h += 8) {
-    records8(lanes, h, num_varyings, front_face, dest + h, int(bytes / 4));
+    records8(lanes, h, num_varyings, front_face, dest + h, int(bytes / 4), tiles_x, tiles);
   }
 }
 

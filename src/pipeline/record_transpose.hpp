@@ -13,6 +13,7 @@
 
 #include "pipeline/triangle_kernels.hpp"
 #include "pipeline/triangle_record.hpp"
+#include "raster/raster.hpp"
 #include "softrast/render_state.hpp"
 
 namespace softrast::detail {
@@ -52,7 +53,14 @@ static_assert(record_bytes(kMaxTransposedVaryings) <= kMaxTransposedBytes);
 // bytes at dest[l] for lane l, and nothing past them; the padding bytes get zeros. A lane that
 // is not ready, or in scalar_planes, gets bytes of no meaning: point it at scratch room of
 // kMaxTransposedBytes. Preconditions: the CPU has AVX2, num_varyings <= kMaxTransposedVaryings.
+// Also the bins of lane l's record, from its bounds (valid for ready lanes): the tile of its
+// top-left pixel, tile[l] = (y0 / kTileSize) tiles_x + x0 / kTileSize, and bit l of `spans`
+// where the bounds reach past that tile.
+struct GroupTiles {
+  alignas(32) uint32_t tile[TriangleLanes::kMaxLanes];
+  uint32_t spans = 0;
+};
 void write_records(const TriangleLanes& lanes, int count, int num_varyings, FrontFace front_face,
-                   std::byte* const* dest, size_t bytes);
+                   std::byte* const* dest, size_t bytes, int tiles_x, GroupTiles& tiles);
 
 }  // namespace softrast::detail
