@@ -325,7 +325,8 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
 // write_records against the field-by-field writers, for lanes of random bits (every field's
 // value range, negative and zero areas, both signs of the 32-bit edge coefficients), every number
 // of varyings it takes, both windings as front and both group widths: the same bytes in every
-// field of every ready lane, zeros in the padding, and not a byte written past a record.
+// field of every ready lane, zeros in the padding, records back to back whole (each record's
+// excess block is overwritten by the next), and nothing written past kRecordSlack.
 TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
   if (cpu_simd_level() < SimdLevel::kAvx2) GTEST_SKIP() << "no AVX2 on this CPU";
   std::mt19937 rng(29);
@@ -360,16 +361,38 @@ TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
       for (int num_varyings = 0; num_varyings <= detail::kMaxTransposedVaryings; ++num_varyings) {
         const size_t bytes = detail::record_bytes(num_varyings);
         for (FrontFace face : {FrontFace::kCounterClockwise, FrontFace::kClockwise}) {
-          // Each lane's record at its own place, unaligned for odd lanes, guard bytes after it.
-          std::vector<std::vector<unsigned char>> room(kLanes, std::vector<unsigned char>(kRoom));
+          // The ready lanes' records back to back in lane order, as the binned draw places them
+          // (from an offset of 8 bytes in odd rounds), the others in scratch room; guard bytes
+          // around both.
+          std::vector<unsigned char> room(kLanes * kRoom, kGuard), scratch(2 * kRoom, kGuard);
+          unsigned char* const base = room.data() + 64 + 8 * (round % 2);
+          unsigned char* const scratch_at = scratch.data() + 64;
           std::byte* dest[kLanes];
+          size_t used = 0;
           for (int l = 0; l < kLanes; ++l) {
-            std::fill(room[l].begin(), room[l].end(), kGuard);
-            dest[l] = reinterpret_cast<std::byte*>(room[l].data() + 8 * (l % 2));
+            const bool ready = (lanes->ready >> l) & 1u;
+            dest[l] = reinterpret_cast<std::byte*>(ready ? base + used : scratch_at);
+            used += ready ? bytes : 0;
           }
           detail::GroupTiles tiles;
           const int tiles_x = 1 + round % 31;
-          detail::write_records(*lanes, count, num_varyings, face, dest, bytes, tiles_x, tiles);
+          detail::write_records(*lanes, count, num_varyings, face, dest, tiles_x, tiles);
+          // Nothing written before the first record, or past kRecordSlack after the last, or
+          // around the scratch room.
+          size_t last_end = 0;
+          for (int l = 0; l < count; ++l) {
+            if ((lanes->ready >> l) & 1u) {
+              last_end = size_t(reinterpret_cast<unsigned char*>(dest[l]) - base) + bytes;
+            }
+          }
+          auto guarded = [](const unsigned char* from, const unsigned char* to) {
+            return std::all_of(from, to, [](unsigned char c) { return c == kGuard; });
+          };
+          ASSERT_TRUE(guarded(room.data(), base));
+          ASSERT_TRUE(guarded(base + last_end + detail::kRecordSlack, room.data() + room.size()));
+          ASSERT_TRUE(guarded(scratch.data(), scratch_at));
+          ASSERT_TRUE(
+              guarded(scratch_at + detail::kMaxTransposedBytes, scratch.data() + scratch.size()));
           for (int l = 0; l < count; ++l) {
             if (!((lanes->ready >> l) & 1u)) continue;
             SCOPED_TRACE(::testing::Message() << "lane " << l << " of " << count << ", "
@@ -392,9 +415,6 @@ TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
               ++binned;
               spanning += (tiles.spans >> l) & 1u;
             }
-            const unsigned char* after = reinterpret_cast<unsigned char*>(dest[l]) + bytes;
-            const unsigned char* end = room[l].data() + kRoom;
-            ASSERT_TRUE(std::all_of(after, end, [](unsigned char c) { return c == kGuard; }));
             ++compared;
           }
         }

@@ -230,7 +230,7 @@ class BinnedDraw {
   void add_group(Chunk& chunk, const TriangleLanes& lanes, int width, std::byte* scratch) {
     int count = 0;
     for (uint32_t m = lanes.ready; m != 0; m &= m - 1) ++count;
-    const uint32_t first = chunk.records.allocate(size_t(count) * record_bytes_);
+    const uint32_t first = chunk.records.allocate(size_t(count) * record_bytes_, kRecordSlack);
     std::byte* const data = reinterpret_cast<std::byte*>(chunk.records.at(first));
     std::byte* dest[TriangleLanes::kMaxLanes];
     for (int l = 0; l < width; ++l) dest[l] = scratch;
@@ -240,8 +240,7 @@ class BinnedDraw {
       to += record_bytes_;
     }
     GroupTiles tiles;
-    write_records(lanes, width, geometry_.num_varyings(), state_.front_face, dest, record_bytes_,
-                  tiles_x_, tiles);
+    write_records(lanes, width, geometry_.num_varyings(), state_.front_face, dest, tiles_x_, tiles);
     uint32_t offset = first;
     const bool box_area = !chunk.box_area.empty();
     for (uint32_t todo = lanes.ready; todo != 0; todo &= todo - 1) {

@@ -39,13 +39,9 @@ namespace {
 }
 
 // Rows [0, 8) (row j: word j of lanes 0-7) transposed: lane l's words [8 block, 8 block + 8) to
-// dest[l] + 32 block, the words below `words` of them (a masked store for the record's last
-// block). `whole`: the caller knows that the record has all eight.
-template <bool whole = false>
+// dest[l] + 32 block, all eight (write_records' room past a record's end).
 [[gnu::always_inline]] inline void transpose_store(const __m256i* r, std::byte* const* dest,
-                                                   int block, int words) {
-  const int left = whole ? 8 : words - 8 * block;
-  if (left <= 0) return;
+                                                   int block) {
   const __m256i t0 = _mm256_unpacklo_epi32(r[0], r[1]), t1 = _mm256_unpackhi_epi32(r[0], r[1]);
   const __m256i t2 = _mm256_unpacklo_epi32(r[2], r[3]), t3 = _mm256_unpackhi_epi32(r[2], r[3]);
   const __m256i t4 = _mm256_unpacklo_epi32(r[4], r[5]), t5 = _mm256_unpackhi_epi32(r[4], r[5]);
@@ -57,30 +53,35 @@ template <bool whole = false>
       _mm256_unpacklo_epi64(t5, t7), _mm256_unpackhi_epi64(t5, t7),
   };
   auto at = [&](int l) { return reinterpret_cast<__m256i*>(dest[l] + 32 * block); };
-  if (left >= 8) {
-    for (int l = 0; l < 4; ++l) {
-      _mm256_storeu_si256(at(l), _mm256_permute2x128_si256(u[l], u[4 + l], 0x20));
-      _mm256_storeu_si256(at(l + 4), _mm256_permute2x128_si256(u[l], u[4 + l], 0x31));
-    }
-    return;
-  }
-  const __m256i mask =
-      _mm256_cmpgt_epi32(_mm256_set1_epi32(left), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
   for (int l = 0; l < 4; ++l) {
-    _mm256_maskstore_epi32(reinterpret_cast<int*>(at(l)), mask,
-                           _mm256_permute2x128_si256(u[l], u[4 + l], 0x20));
-    _mm256_maskstore_epi32(reinterpret_cast<int*>(at(l + 4)), mask,
-                           _mm256_permute2x128_si256(u[l], u[4 + l], 0x31));
+    _mm256_storeu_si256(at(l), _mm256_permute2x128_si256(u[l], u[4 + l], 0x20));
+    _mm256_storeu_si256(at(l + 4), _mm256_permute2x128_si256(u[l], u[4 + l], 0x31));
   }
 }
 
 // Lanes [h, h + 8) of the group, the rows of each block of eight words made just before it is
 // stored.
 [[gnu::always_inline]] inline void records8(const TriangleLanes& lanes, int h, int num_varyings,
-                                            FrontFace front_face, std::byte* const* dest, int words,
+                                            FrontFace front_face, std::byte* const* dest,
                                             int tiles_x, GroupTiles& tiles) {
   static_assert(record_bytes(0) >= 40 * 4, "the first five blocks are whole in every record");
   __m256i r[8];
+  // Words from 40 first: the varyings' planes but the first (a0, dadx, dady each; var[i][k] is
+  // plane 3 i + k, word 39 + 3 i + k). The last block of a record may reach past its end, into the
+  // next record's first block, which is stored after it.
+  const float* planes = &lanes.var[0][0][h];
+  const int count = 3 * num_varyings;
+  for (int first = 1, block = 5; first < count; first += 8, ++block) {
+    if (first + 8 <= count) {
+      for (int i = 0; i < 8; ++i) r[i] = row(planes + (first + i) * TriangleLanes::kMaxLanes);
+    } else {
+      for (int i = 0; i < 8; ++i) {
+        r[i] = first + i < count ? row(planes + (first + i) * TriangleLanes::kMaxLanes)
+                                 : _mm256_setzero_si256();
+      }
+    }
+    transpose_store(r, dest, block);
+  }
   // Words 0-23: the edges, the bounds, the blocks.
   r[0] = row(&lanes.edge_a[0][h]);  // EdgeFunction: a and b sign-extended from 32 bits, c
   r[1] = _mm256_srai_epi32(r[0], 31);
@@ -89,7 +90,7 @@ template <bool whole = false>
   word_rows(&lanes.edge_c[0][h], r[4], r[5]);
   r[6] = row(&lanes.edge_a[1][h]);
   r[7] = _mm256_srai_epi32(r[6], 31);
-  transpose_store<true>(r, dest, 0, words);
+  transpose_store(r, dest, 0);
   r[0] = row(&lanes.edge_b[1][h]);
   r[1] = _mm256_srai_epi32(r[0], 31);
   word_rows(&lanes.edge_c[1][h], r[2], r[3]);
@@ -97,12 +98,12 @@ template <bool whole = false>
   r[5] = _mm256_srai_epi32(r[4], 31);
   r[6] = row(&lanes.edge_b[2][h]);
   r[7] = _mm256_srai_epi32(r[6], 31);
-  transpose_store<true>(r, dest, 1, words);
+  transpose_store(r, dest, 1);
   word_rows(&lanes.edge_c[2][h], r[0], r[1]);
   for (int i = 0; i < 4; ++i) r[2 + i] = row(&lanes.bounds[i][h]);
   r[6] = row(&lanes.blocks[0][h]);
   r[7] = row(&lanes.blocks[1][h]);
-  transpose_store<true>(r, dest, 2, words);
+  transpose_store(r, dest, 2);
   {  // The bins (GroupTiles), from the bounds x0, y0, x1, y1 in r[2..6).
     static_assert(kTileSize == 1 << 6);
     const __m256i one = _mm256_set1_epi32(1);
@@ -125,7 +126,7 @@ template <bool whole = false>
   r[3] = row(&lanes.y_ref[h]);
   word_rows(&lanes.z[0][h], r[4], r[5]);
   word_rows(&lanes.z[1][h], r[6], r[7]);
-  transpose_store<true>(r, dest, 3, words);
+  transpose_store(r, dest, 3);
   // Words 32-39: the rest of the fixed fields, the first varying's a0.
   word_rows(&lanes.z[2][h], r[0], r[1]);
   for (int k = 0; k < 3; ++k) r[2 + k] = row(&lanes.inv_w[k][h]);
@@ -141,31 +142,17 @@ template <bool whole = false>
         _mm256_shuffle_ps(_mm256_castsi256_ps(fa), _mm256_castsi256_ps(fb), 0x88);
     r[6] = _mm256_and_si256(_mm256_permute4x64_epi64(_mm256_castps_si256(words_ab), 0xd8), one);
   }
-  // Words from 39: the varyings' planes, a0, dadx, dady each (var[i][k] is plane 3 i + k).
-  const float* planes = &lanes.var[0][0][h];
-  const int count = 3 * num_varyings;
   r[7] = count > 0 ? row(planes) : _mm256_setzero_si256();
-  transpose_store<true>(r, dest, 4, words);
-  for (int first = 1, block = 5; first < count; first += 8, ++block) {
-    if (first + 8 <= count) {
-      for (int i = 0; i < 8; ++i) r[i] = row(planes + (first + i) * TriangleLanes::kMaxLanes);
-    } else {
-      for (int i = 0; i < 8; ++i) {
-        r[i] = first + i < count ? row(planes + (first + i) * TriangleLanes::kMaxLanes)
-                                 : _mm256_setzero_si256();
-      }
-    }
-    transpose_store(r, dest, block, words);
-  }
+  transpose_store(r, dest, 4);
 }
 
 }  // namespace
 
 void write_records(const TriangleLanes& lanes, int count, int num_varyings, FrontFace front_face,
-                   std::byte* const* dest, size_t bytes, int tiles_x, GroupTiles& tiles) {
+                   std::byte* const* dest, int tiles_x, GroupTiles& tiles) {
   tiles.spans = 0;
   for (int h = 0; h < count; h += 8) {
-    records8(lanes, h, num_varyings, front_face, dest + h, int(bytes / 4), tiles_x, tiles);
+    records8(lanes, h, num_varyings, front_face, dest + h, tiles_x, tiles);
   }
 }
 

@@ -72,9 +72,12 @@ constexpr size_t record_bytes(int num_varyings, bool with_vertices = false) {
 class RecordArena {
  public:
   void clear() { used_ = 0; }
-  // Room for `bytes` more bytes; returns the offset of the new space.
-  uint32_t allocate(size_t bytes) {
-    if (used_ + bytes > data_.size()) data_.resize(std::max(2 * data_.size(), used_ + bytes));
+  // Room for `bytes` more bytes, and `slack` writable bytes after them (which the next
+  // allocation takes); returns the offset of the new space.
+  uint32_t allocate(size_t bytes, size_t slack = 0) {
+    if (used_ + bytes + slack > data_.size()) {
+      data_.resize(std::max(2 * data_.size(), used_ + bytes + slack));
+    }
     size_t offset = used_;
     used_ += bytes;
     return uint32_t(offset);
