@@ -199,15 +199,15 @@ class BinnedDraw {
       batch.num_varyings = geometry_.num_varyings();
       TriangleLanes lanes;
       const size_t width = size_t(triangle_kernel_.lanes);
-      // Groups of set-up triangles only, at least three of them, take write_records
-      // (record_transpose.hpp; below three, field by field was fewer instructions), where the
+      // Groups of set-up triangles only, at least four of them, take write_records
+      // (record_transpose.hpp; below four, field by field was fewer instructions), where the
       // records hold no vertices and at most kMaxTransposedVaryings varyings.
       const bool transposed = !scanline_ && batch.num_varyings <= kMaxTransposedVaryings;
       alignas(32) std::byte scratch[kMaxTransposedBytes];
       for (size_t t = begin; t < end; t += width) {
         triangle_kernel_.fn(batch, t, int(std::min(width, end - t)), lanes);
-        const uint32_t ready = lanes.ready, two = ready & (ready - 1);
-        if (transposed && (lanes.scalar | lanes.scalar_planes) == 0 && (two & (two - 1)) != 0) {
+        const uint32_t ready = lanes.ready, two = ready & (ready - 1), three = two & (two - 1);
+        if (transposed && (lanes.scalar | lanes.scalar_planes) == 0 && (three & (three - 1)) != 0) {
           add_group(chunk, lanes, int(width), scratch);
           continue;
         }
