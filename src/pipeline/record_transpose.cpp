@@ -29,13 +29,19 @@ namespace {
   return _mm256_load_si256(static_cast<const __m256i*>(p));
 }
 
+// The low (kPick 0x88) or high (0xdd) words of eight 64-bit lanes, lanes 0-3 in a and 4-7 in b.
+template <int kPick>
+[[gnu::always_inline]] inline __m256i words_of(__m256i a, __m256i b) {
+  // Per 128-bit half, the even (odd) words of a then b: lanes 0 1 4 5 | 2 3 6 7.
+  const __m256 w = _mm256_shuffle_ps(_mm256_castsi256_ps(a), _mm256_castsi256_ps(b), kPick);
+  return _mm256_permute4x64_epi64(_mm256_castps_si256(w), 0xd8);
+}
+
 // The low and high words of lanes [0, 8) of an array of 64-bit fields.
 [[gnu::always_inline]] inline void word_rows(const void* p, __m256i& low, __m256i& high) {
-  const __m256 a = _mm256_load_ps(static_cast<const float*>(p));      // lanes 0-3
-  const __m256 b = _mm256_load_ps(static_cast<const float*>(p) + 8);  // lanes 4-7
-  // Per 128-bit half, the even (odd) words of a then b: lanes 0 1 4 5 | 2 3 6 7.
-  low = _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, 0x88)), 0xd8);
-  high = _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, 0xdd)), 0xd8);
+  const __m256i a = row(p), b = row(static_cast<const std::byte*>(p) + 32);
+  low = words_of<0x88>(a, b);
+  high = words_of<0xdd>(a, b);
 }
 
 // Rows [0, 8) (row j: word j of lanes 0-7) transposed: lane l's words [8 block, 8 block + 8) to
@@ -65,6 +71,7 @@ namespace {
                                             FrontFace front_face, std::byte* const* dest,
                                             int tiles_x, GroupTiles& tiles) {
   static_assert(record_bytes(0) >= 40 * 4, "the first five blocks are whole in every record");
+  const __m256i one = _mm256_set1_epi32(1);
   __m256i r[8];
   // Words from 40 first: the varyings' planes but the first (a0, dadx, dady each; var[i][k] is
   // plane 3 i + k, word 39 + 3 i + k). The last block of a record may reach past its end, into the
@@ -106,7 +113,6 @@ namespace {
   transpose_store(r, dest, 2);
   {  // The bins (GroupTiles), from the bounds x0, y0, x1, y1 in r[2..6).
     static_assert(kTileSize == 1 << 6);
-    const __m256i one = _mm256_set1_epi32(1);
     const __m256i tx0 = _mm256_srli_epi32(r[2], 6), ty0 = _mm256_srli_epi32(r[3], 6);
     const __m256i tx1 = _mm256_srli_epi32(_mm256_sub_epi32(r[4], one), 6);
     const __m256i ty1 = _mm256_srli_epi32(_mm256_sub_epi32(r[5], one), 6);
@@ -117,7 +123,6 @@ namespace {
                        _mm256_add_epi32(_mm256_mullo_epi32(ty0, _mm256_set1_epi32(tiles_x)), tx0));
   }
   // Words 24-31: small (a bool, then the record's padding), the interpolants from x_ref.
-  const __m256i one = _mm256_set1_epi32(1);
   r[0] = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(lanes.small >> h)),
                                             _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)),
                           one);
@@ -138,9 +143,7 @@ namespace {
     const bool ccw = front_face == FrontFace::kCounterClockwise;
     const __m256i fa = ccw ? _mm256_cmpgt_epi64(zero, a) : _mm256_cmpgt_epi64(a, zero);
     const __m256i fb = ccw ? _mm256_cmpgt_epi64(zero, b) : _mm256_cmpgt_epi64(b, zero);
-    const __m256 words_ab =
-        _mm256_shuffle_ps(_mm256_castsi256_ps(fa), _mm256_castsi256_ps(fb), 0x88);
-    r[6] = _mm256_and_si256(_mm256_permute4x64_epi64(_mm256_castps_si256(words_ab), 0xd8), one);
+    r[6] = _mm256_and_si256(words_of<0x88>(fa, fb), one);
   }
   r[7] = count > 0 ? row(planes) : _mm256_setzero_si256();
   transpose_store(r, dest, 4);

@@ -48,22 +48,26 @@ inline constexpr int kMaxTransposedVaryings = 8;
 inline constexpr size_t kMaxTransposedBytes = 256;
 static_assert(record_bytes(kMaxTransposedVaryings) <= kMaxTransposedBytes);
 
-// Writes the records of lanes [0, count) (count 8 or 16) as write_coverage and write_planes
-// write them (without the scanline rasterizer's vertices): record_bytes(num_varyings) bytes at
-// dest[l] for lane l, the padding bytes zero. It stores whole 32-byte blocks, the varyings' last
-// ones first, so it also writes the bytes up to the next multiple of 32 past a record's end
-// (kRecordSlack at most): records whose dest are in increasing lane order and back to back get
-// the next record's bytes over that excess; the last record needs the room. A lane that is not
-// ready, or in scalar_planes, gets bytes of no meaning: point it at scratch room of
-// kMaxTransposedBytes. Preconditions: the CPU has AVX2, num_varyings <= kMaxTransposedVaryings.
+// write_records stores whole 32-byte blocks: past a record's end it writes up to kRecordSlack
+// bytes more.
 inline constexpr size_t kRecordSlack = 32;
-// Also the bins of lane l's record, from its bounds (valid for ready lanes): the tile of its
-// top-left pixel, tile[l] = (y0 / kTileSize) tiles_x + x0 / kTileSize, and bit l of `spans`
-// where the bounds reach past that tile.
+
+// The bins of a group's records (write_records), from their bounds (valid for ready lanes): the
+// tile of lane l's top-left pixel, tile[l] = (y0 / kTileSize) tiles_x + x0 / kTileSize, and bit l
+// of `spans` where the bounds reach past that tile.
 struct GroupTiles {
   alignas(32) uint32_t tile[TriangleLanes::kMaxLanes];
   uint32_t spans = 0;
 };
+
+// Writes the records of lanes [0, count) (count 8 or 16) as write_coverage and write_planes
+// write them (without the scanline rasterizer's vertices): record_bytes(num_varyings) bytes at
+// dest[l] for lane l, the padding bytes zero, and their bins into `tiles`. The varyings' last
+// blocks are stored first, so records whose dest are in increasing lane order and back to back
+// get the next record's bytes over a record's excess; the last record needs kRecordSlack bytes of
+// room after it. A lane that is not ready, or in scalar_planes, gets bytes of no meaning: point
+// it at scratch room of kMaxTransposedBytes. Preconditions: the CPU has AVX2, num_varyings <=
+// kMaxTransposedVaryings.
 void write_records(const TriangleLanes& lanes, int count, int num_varyings, FrontFace front_face,
                    std::byte* const* dest, int tiles_x, GroupTiles& tiles);
 
