@@ -442,38 +442,42 @@ TEST(SimdSampler, MatchesScalarSamplingBitForBitAtEveryLevel) {
   }
 }
 
-// The two forms of each gather (simd::isa): the instruction and one load per lane, against the
-// elements they should read, at indices all over a table (the first and last elements among
-// them), inside functions compiled for the width's level as the shaders are.
+// The two forms of each gather (simd::isa): the instruction and one load per lane (with the
+// indices by either route, simd::IndexRoute), against the elements they should read, at indices
+// all over a table (the first and last elements among them), inside functions compiled for the
+// width's level as the shaders are.
 // r[i] = table[index[i]] by the form asked for, and the pairs lo[i] = table[index[i]], hi[i] =
 // table[index[i] + 1] through gather_pair in that mode. Inlined into the functions below.
 template <int N>
 SOFTRAST_SIMD_INLINE void gather_by(const int32_t* table, const typename simd::Native<N>::I& index,
-                                    bool loads, typename simd::Native<N>::I& r,
-                                    typename simd::Native<N>::I& lo,
+                                    bool loads, simd::IndexRoute route,
+                                    typename simd::Native<N>::I& r, typename simd::Native<N>::I& lo,
                                     typename simd::Native<N>::I& hi) {
-  if (loads) {
-    simd::isa::gather_loads(table, index, r);
-  } else {
+  if (!loads) {
     simd::isa::gather_instruction(table, index, r);
+  } else if constexpr (N == 8) {
+    simd::isa::gather_loads(table, index, r, route);
+  } else {
+    simd::isa::gather_loads(table, index, r);
   }
   set_gather_mode(loads ? GatherMode::kLoads : GatherMode::kInstruction);
-  simd::isa::gather_pair(table, index, lo, hi);
+  simd::isa::gather_pair(table, index, lo, hi, route);
 }
 template <int N>
 struct GatherForms {
   using V = typename simd::Native<N>::I;
-  static void run(const int32_t* table, const V& index, bool loads, V& r, V& lo, V& hi);
+  static void run(const int32_t* table, const V& index, bool loads, simd::IndexRoute route, V& r,
+                  V& lo, V& hi);
 };
 template <>
 [[gnu::target("avx2")]] void GatherForms<8>::run(const int32_t* table, const V& index, bool loads,
-                                                 V& r, V& lo, V& hi) {
-  gather_by<8>(table, index, loads, r, lo, hi);
+                                                 simd::IndexRoute route, V& r, V& lo, V& hi) {
+  gather_by<8>(table, index, loads, route, r, lo, hi);
 }
 template <>
 [[gnu::target("avx512f,avx512bw,avx512dq,avx512vl")]] void GatherForms<16>::run(
-    const int32_t* table, const V& index, bool loads, V& r, V& lo, V& hi) {
-  gather_by<16>(table, index, loads, r, lo, hi);
+    const int32_t* table, const V& index, bool loads, simd::IndexRoute route, V& r, V& lo, V& hi) {
+  gather_by<16>(table, index, loads, route, r, lo, hi);
 }
 
 template <int N>
@@ -489,15 +493,17 @@ void expect_gathers_read_their_elements() {
     for (int i = 0; i < N; ++i) index[i] = pick(rng);
     if (round == 0) index[0] = 0, index[N - 1] = kSize - 2;
     for (bool loads : {false, true}) {
-      V r, lo, hi;
-      GatherForms<N>::run(table.data(), index, loads, r, lo, hi);
-      for (int i = 0; i < N; ++i) {
-        ASSERT_EQ(r[i], table[size_t(index[i])])
-            << (loads ? "loads" : "instruction") << " lane " << i;
-        ASSERT_EQ(lo[i], table[size_t(index[i])])
-            << (loads ? "loads" : "instruction") << " lane " << i;
-        ASSERT_EQ(hi[i], table[size_t(index[i]) + 1])
-            << (loads ? "loads" : "instruction") << " lane " << i;
+      for (simd::IndexRoute route : {simd::IndexRoute::kMemory, simd::IndexRoute::kRegisters}) {
+        const char* form = !loads                               ? "instruction"
+                           : route == simd::IndexRoute::kMemory ? "loads, indices through memory"
+                                                                : "loads, indices by extracts";
+        V r, lo, hi;
+        GatherForms<N>::run(table.data(), index, loads, route, r, lo, hi);
+        for (int i = 0; i < N; ++i) {
+          ASSERT_EQ(r[i], table[size_t(index[i])]) << form << " lane " << i;
+          ASSERT_EQ(lo[i], table[size_t(index[i])]) << form << " lane " << i;
+          ASSERT_EQ(hi[i], table[size_t(index[i]) + 1]) << form << " lane " << i;
+        }
       }
     }
   }

@@ -356,6 +356,16 @@ SOFTRAST_SIMD_INLINE bool loads_for_gathers() {
   return g_loads_for_gathers[N == 16];
 }
 
+// How a gather by loads (loads_for_gathers) takes the lanes' indices out of the vector register:
+// stored and read back by scalar loads (kMemory), which cost the load ports only, or two at a time
+// by 64-bit extracts (kRegisters), which cost the shuffle port but do not wait for a store to
+// forward. Which is faster depends on the code around the gather, so each site says; measured
+// on an AMD Zen 3 (AVX2): the sampler's texel loads by registers, quad_grid texture 5.7 % faster
+// at one thread; the triangle kernel's vertex loads by memory (by registers, spheres gouraud was
+// about 10 % slower: its transposes keep the shuffle port busy). Only the 8-lane (AVX2) forms
+// have both routes; the others ignore it.
+enum class IndexRoute { kMemory, kRegisters };
+
 namespace isa {
 
 // The comparison predicate must be a constant after inlining (it always is: an operator's).
@@ -493,7 +503,8 @@ inline int sign_bits(const Native<4>::I& a) {
 }
 
 // r[i] = base[index[i]] for 32-bit elements.
-inline void gather(const int32_t* base, const Native<4>::I& index, Native<4>::I& r) {
+inline void gather(const int32_t* base, const Native<4>::I& index, Native<4>::I& r,
+                   IndexRoute = IndexRoute::kMemory) {
   for (int i = 0; i < 4; ++i) {
     int32_t v;
     std::memcpy(&v, base + index[i], sizeof v);  // the base may be a byte array
@@ -520,6 +531,24 @@ SOFTRAST_SIMD_INLINE void through_memory(int32_t (&at)[Lanes]) {
   *reinterpret_cast<V*>(at + 8) =
       __builtin_shufflevector(index, index, 8, 9, 10, 11, 12, 13, 14, 15);
   through_memory(at);
+}
+// The 8 indices of an AVX2 register as scalars for the loads, by `route`: stored and read back
+// (through_memory), or taken out of the register 64 bits (two indices) at a time.
+[[gnu::target("avx2")]] inline void index_lanes(const Native<8>::I& index, IndexRoute route,
+                                                int32_t (&at)[8]) {
+  if (route == IndexRoute::kMemory) {
+    _mm256_store_si256(reinterpret_cast<__m256i*>(at), __m256i(index));
+    through_memory(at);
+    return;
+  }
+  const __m128i low = _mm256_castsi256_si128(__m256i(index));
+  const __m128i high = _mm256_extracti128_si256(__m256i(index), 1);
+  const uint64_t q[4] = {uint64_t(_mm_cvtsi128_si64(low)), uint64_t(_mm_extract_epi64(low, 1)),
+                         uint64_t(_mm_cvtsi128_si64(high)), uint64_t(_mm_extract_epi64(high, 1))};
+  for (int i = 0; i < 4; ++i) {
+    at[2 * i] = int32_t(uint32_t(q[i]));
+    at[2 * i + 1] = int32_t(uint32_t(q[i] >> 32));
+  }
 }
 [[gnu::target("avx2")]] inline __m128i load_lanes4(const int32_t* base, const int32_t* at) {
   auto lane = [base](int32_t i) {
@@ -551,10 +580,10 @@ SOFTRAST_SIMD_INLINE void through_memory(int32_t (&at)[Lanes]) {
                                                _mm256_set1_epi32(-1), 4));
 }
 [[gnu::target("avx2")]] inline void gather_loads(const int32_t* base, const Native<8>::I& index,
-                                                 Native<8>::I& r) {
+                                                 Native<8>::I& r,
+                                                 IndexRoute route = IndexRoute::kMemory) {
   alignas(32) int32_t at[8];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(at), __m256i(index));
-  through_memory(at);
+  index_lanes(index, route, at);
   r = Native<8>::I(join(load_lanes4(base, at), load_lanes4(base, at + 4)));
 }
 [[gnu::target("avx512f")]] inline void gather_instruction(const int32_t* base,
@@ -571,15 +600,16 @@ SOFTRAST_SIMD_INLINE void through_memory(int32_t (&at)[Lanes]) {
                          join(load_lanes4(base, at + 8), load_lanes4(base, at + 12))));
 }
 [[gnu::target("avx2")]] inline void gather(const int32_t* base, const Native<8>::I& index,
-                                           Native<8>::I& r) {
+                                           Native<8>::I& r,
+                                           IndexRoute route = IndexRoute::kMemory) {
   if (loads_for_gathers<8>()) {
-    gather_loads(base, index, r);
+    gather_loads(base, index, r, route);
   } else {
     gather_instruction(base, index, r);
   }
 }
 [[gnu::target("avx512f")]] inline void gather(const int32_t* base, const Native<16>::I& index,
-                                              Native<16>::I& r) {
+                                              Native<16>::I& r, IndexRoute = IndexRoute::kMemory) {
   if (loads_for_gathers<16>()) {
     gather_loads(base, index, r);
   } else {
@@ -598,10 +628,10 @@ SOFTRAST_SIMD_INLINE void through_memory(int32_t (&at)[Lanes]) {
   c = _mm256_i32gather_epi64(pairs, _mm256_extracti128_si256(i, 1), 4);
 }
 [[gnu::target("avx2")]] inline void pairs_loads(const int32_t* base, const Native<8>::I& index,
-                                                __m256i& a, __m256i& c) {
+                                                __m256i& a, __m256i& c,
+                                                IndexRoute route = IndexRoute::kMemory) {
   alignas(32) int32_t at[8];
-  _mm256_store_si256(reinterpret_cast<__m256i*>(at), __m256i(index));
-  through_memory(at);
+  index_lanes(index, route, at);
   a = join(load_pairs2(base, at), load_pairs2(base, at + 2));
   c = join(load_pairs2(base, at + 4), load_pairs2(base, at + 6));
 }
@@ -687,7 +717,7 @@ inline void mul_round15(const Native<4>::I& a, const Native<4>::I& b, Native<4>:
 // lo[i] = base[index[i]] and hi[i] = base[index[i] + 1]: two neighbouring 32-bit elements per
 // lane with one 64-bit load (half the loads of two gathers).
 inline void gather_pair(const int32_t* base, const Native<4>::I& index, Native<4>::I& lo,
-                        Native<4>::I& hi) {
+                        Native<4>::I& hi, IndexRoute = IndexRoute::kMemory) {
   for (int i = 0; i < 4; ++i) {
     int32_t v[2];
     std::memcpy(v, base + index[i], sizeof v);
@@ -696,11 +726,12 @@ inline void gather_pair(const int32_t* base, const Native<4>::I& index, Native<4
   }
 }
 [[gnu::target("avx2")]] inline void gather_pair(const int32_t* base, const Native<8>::I& index,
-                                                Native<8>::I& lo, Native<8>::I& hi) {
+                                                Native<8>::I& lo, Native<8>::I& hi,
+                                                IndexRoute route = IndexRoute::kMemory) {
   // a = l0 h0 l1 h1 | l2 h2 l3 h3, c = l4 h4 l5 h5 | l6 h6 l7 h7 (32-bit elements)
   __m256i ai, ci;
   if (loads_for_gathers<8>()) {
-    pairs_loads(base, index, ai, ci);
+    pairs_loads(base, index, ai, ci, route);
   } else {
     pairs_instruction(base, index, ai, ci);
   }
@@ -711,7 +742,8 @@ inline void gather_pair(const int32_t* base, const Native<4>::I& index, Native<4
   hi = Native<8>::I(_mm256_permute4x64_epi64(_mm256_castps_si256(h), 0xd8));
 }
 [[gnu::target("avx512f")]] inline void gather_pair(const int32_t* base, const Native<16>::I& index,
-                                                   Native<16>::I& lo, Native<16>::I& hi) {
+                                                   Native<16>::I& lo, Native<16>::I& hi,
+                                                   IndexRoute = IndexRoute::kMemory) {
   // a = lanes 0 to 7's pairs, c = lanes 8 to 15's (each pair two 32-bit elements, l then h)
   __m512i a, c;
   if (loads_for_gathers<16>()) {
@@ -787,9 +819,10 @@ SOFTRAST_SIMD_INLINE bool any(const Int<N>& mask) {
 
 // Lane i = base[index[i]]; every index must be valid.
 template <int N>
-SOFTRAST_SIMD_INLINE Int<N> gather(const int32_t* base, const Int<N>& index) {
+SOFTRAST_SIMD_INLINE Int<N> gather(const int32_t* base, const Int<N>& index,
+                                   IndexRoute route = IndexRoute::kMemory) {
   Int<N> r;
-  for (int k = 0; k < Int<N>::kParts; ++k) isa::gather(base, index.p[k], r.p[k]);
+  for (int k = 0; k < Int<N>::kParts; ++k) isa::gather(base, index.p[k], r.p[k], route);
   return r;
 }
 
@@ -804,8 +837,10 @@ SOFTRAST_SIMD_INLINE Float<N> lookup16(const float* table, const Int<N>& index) 
 // Lane i of lo = base[index[i]], of hi = base[index[i] + 1]; both must be valid.
 template <int N>
 SOFTRAST_SIMD_INLINE void gather_pair(const int32_t* base, const Int<N>& index, Int<N>& lo,
-                                      Int<N>& hi) {
-  for (int k = 0; k < Int<N>::kParts; ++k) isa::gather_pair(base, index.p[k], lo.p[k], hi.p[k]);
+                                      Int<N>& hi, IndexRoute route = IndexRoute::kMemory) {
+  for (int k = 0; k < Int<N>::kParts; ++k) {
+    isa::gather_pair(base, index.p[k], lo.p[k], hi.p[k], route);
+  }
 }
 
 // Lane constants, loaded as vectors (GCC builds a vector lane by lane otherwise).

@@ -17,6 +17,9 @@
 namespace softrast {
 namespace detail {
 
+// The sampler's gathers take their indices out of the vector by extracts (simd::IndexRoute).
+inline constexpr simd::IndexRoute kTexelRoute = simd::IndexRoute::kRegisters;
+
 // texel_floor for 16 lanes: floor(x) and x - floor(x); NaN and |x| >= 1e9 give texel 0, 0.
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Int<N> texel_floor(const simd::Float<N>& x, simd::Float<N>& fraction) {
@@ -85,9 +88,9 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> unpack_texel(const simd::Int<N>& texel, bool 
   simd::Int<N> byte(0xff);
   if (decode) {
     const int32_t* table = reinterpret_cast<const int32_t*>(srgb_decode_table());
-    return {simd::bit_cast_float(simd::gather<N>(table, texel & byte)),
-            simd::bit_cast_float(simd::gather<N>(table, (texel >> 8) & byte)),
-            simd::bit_cast_float(simd::gather<N>(table, (texel >> 16) & byte)),
+    return {simd::bit_cast_float(simd::gather<N>(table, texel & byte, kTexelRoute)),
+            simd::bit_cast_float(simd::gather<N>(table, (texel >> 8) & byte, kTexelRoute)),
+            simd::bit_cast_float(simd::gather<N>(table, (texel >> 16) & byte, kTexelRoute)),
             simd::to_float(texel >> 24) * k};
   }
   return {simd::to_float(texel & byte) * k, simd::to_float((texel >> 8) & byte) * k,
@@ -299,8 +302,9 @@ template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> fetch(const Texture& t, const simd::Int<N>& i,
                                          const simd::Int<N>& j, const simd::Int<N>& w,
                                          const simd::Int<N>& offset, bool decode) {
-  return unpack_texel<N>(
-      simd::gather<N>(reinterpret_cast<const int32_t*>(t.texels()), offset + j * w + i), decode);
+  return unpack_texel<N>(simd::gather<N>(reinterpret_cast<const int32_t*>(t.texels()),
+                                         offset + j * w + i, kTexelRoute),
+                         decode);
 }
 
 template <int N>
@@ -333,14 +337,14 @@ SOFTRAST_SIMD_INLINE void bilinear_texels(const Texture& t, const Sampler& s,
   if (simd::bits(i1 == i0 + one) == 0xffffu) {
     // No lane wraps between its two columns: texels (i0, j) and (i1, j) are neighbours in memory,
     // so one 64-bit load per lane and row fetches both (the same texels, half the loads).
-    simd::gather_pair<N>(texels, offset + j0 * w + i0, b0, b1);
-    simd::gather_pair<N>(texels, offset + j1 * w + i0, t0, t1);
+    simd::gather_pair<N>(texels, offset + j0 * w + i0, b0, b1, kTexelRoute);
+    simd::gather_pair<N>(texels, offset + j1 * w + i0, t0, t1, kTexelRoute);
     return;
   }
-  b0 = simd::gather<N>(texels, offset + j0 * w + i0);
-  b1 = simd::gather<N>(texels, offset + j0 * w + i1);
-  t0 = simd::gather<N>(texels, offset + j1 * w + i0);
-  t1 = simd::gather<N>(texels, offset + j1 * w + i1);
+  b0 = simd::gather<N>(texels, offset + j0 * w + i0, kTexelRoute);
+  b1 = simd::gather<N>(texels, offset + j0 * w + i1, kTexelRoute);
+  t0 = simd::gather<N>(texels, offset + j1 * w + i0, kTexelRoute);
+  t1 = simd::gather<N>(texels, offset + j1 * w + i1, kTexelRoute);
 }
 
 // One level per lane (size w x h, first texel `offset`), nearest or bilinear: the arithmetic of
