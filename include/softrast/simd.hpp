@@ -360,10 +360,11 @@ SOFTRAST_SIMD_INLINE bool loads_for_gathers() {
 // stored and read back by scalar loads (kMemory), which cost the load ports only, or two at a time
 // by 64-bit extracts (kRegisters), which cost the shuffle port but do not wait for a store to
 // forward. Which is faster depends on the code around the gather, so each site says; measured
-// on an AMD Zen 3 (AVX2): the sampler's texel loads by registers, quad_grid texture 5.7 % faster
-// at one thread; the triangle kernel's vertex loads by memory (by registers, spheres gouraud was
-// about 10 % slower: its transposes keep the shuffle port busy). Only the 8-lane (AVX2) forms
-// have both routes; the others ignore it.
+// on an AMD Zen 3 (AVX2), medians of alternating runs at one thread: the sampler's texel loads
+// by registers (quad_grid texture 4 to 6 % faster, diablo3 4 %); the triangle kernel's vertex
+// loads by memory (by registers, spheres gouraud was 11 to 13 % slower in three sets of runs:
+// its transposes keep the shuffle port busy). Only the 8-lane (AVX2) forms have both routes;
+// the others ignore it.
 enum class IndexRoute { kMemory, kRegisters };
 
 namespace isa {
