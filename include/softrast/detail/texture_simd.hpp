@@ -164,10 +164,12 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> filter_rgba8(const simd::Int<N>& b0, const si
   for (int k = 0; k < I::kParts; ++k) {
     for (int half = 0; half < 2; ++half) {
       const V v = (half == 0 ? red_blue : green_alpha).p[k];
-      // v / 128 is exact, and then the same multiplication as Texture::texel's.
-      const Fn to_level = Fn{} + 1.0f / 128.0f, k255 = Fn{} + 1.0f / 255.0f;
-      Fn low = (__builtin_convertvector(v & 0xffff, Fn) * to_level) * k255;
-      Fn high = (__builtin_convertvector(v >> 16, Fn) * to_level) * k255;
+      // (v / 128) * (1 / 255) as Texture::texel computes it, in one multiplication: v / 128 is
+      // exact, and so is (1 / 255) / 128 (both scale by a power of two), so v times the latter
+      // rounds the same real number once, as the two multiplications do.
+      const Fn to_unit = Fn{} + (1.0f / 255.0f) * (1.0f / 128.0f);
+      Fn low = __builtin_convertvector(v & 0xffff, Fn) * to_unit;
+      Fn high = __builtin_convertvector(v >> 16, Fn) * to_unit;
       (half == 0 ? out.x : out.y).p[k] = low;
       (half == 0 ? out.z : out.w).p[k] = high;
     }
@@ -409,9 +411,9 @@ SOFTRAST_SIMD_INLINE void level_lanes(const Texture& t, const simd::Int<N>& l, s
   }
   const auto* table = reinterpret_cast<const int32_t*>(&t.level(0));
   I at = l * I(4);
-  w = simd::gather<N>(table, at);
-  h = simd::gather<N>(table, at + I(1));
-  offset = simd::gather<N>(table, at + I(2));
+  w = simd::gather<N>(table, at, kTexelRoute);
+  h = simd::gather<N>(table, at + I(1), kTexelRoute);
+  offset = simd::gather<N>(table, at + I(2), kTexelRoute);
 }
 
 // Samples `texture` at 16 texture coordinates with the sampler's filter and wrap modes, inline
