@@ -453,12 +453,10 @@ SOFTRAST_SIMD_INLINE void gather_by(const int32_t* table, const typename simd::N
                                     bool loads, simd::IndexRoute route,
                                     typename simd::Native<N>::I& r, typename simd::Native<N>::I& lo,
                                     typename simd::Native<N>::I& hi) {
-  if (!loads) {
-    simd::isa::gather_instruction(table, index, r);
-  } else if constexpr (N == 8) {
-    simd::isa::gather_loads(table, index, r, route);
+  if (loads) {
+    simd::isa::gather_loads(table, index, r, route);  // (16 lanes: the route is ignored)
   } else {
-    simd::isa::gather_loads(table, index, r);
+    simd::isa::gather_instruction(table, index, r);
   }
   set_gather_mode(loads ? GatherMode::kLoads : GatherMode::kInstruction);
   simd::isa::gather_pair(table, index, lo, hi, route);

@@ -594,7 +594,8 @@ SOFTRAST_SIMD_INLINE void through_memory(int32_t (&at)[Lanes]) {
                                                 __m512i(index), base, 4));
 }
 [[gnu::target("avx512f")]] inline void gather_loads(const int32_t* base, const Native<16>::I& index,
-                                                    Native<16>::I& r) {
+                                                    Native<16>::I& r,
+                                                    IndexRoute = IndexRoute::kMemory) {
   alignas(64) int32_t at[16];
   store_halves(at, index);
   r = Native<16>::I(join(join(load_lanes4(base, at), load_lanes4(base, at + 4)),
