@@ -370,6 +370,11 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   f.color = {F(0.0f), F(0.0f), F(0.0f), F(1.0f)};
   const I covered = f.live;
   shader.template shade<N>(f);
+  // The opaque output packed at once: f.color is dead from here. (Packed at the write, below,
+  // the four vectors of f.color were kept across the rest, spilled where a shader's two output
+  // forms join: about 12 instructions a call of the texture shader's block.)
+  I packed{};
+  if (blend_mode == BlendMode::kOpaque) packed = f.has_rgba8 ? f.rgba8 : pack_rgba8<N>(f.color);
   if constexpr (!DeclaresDiscards<S>) {
     if (resolved && simd::bits(f.live) != simd::bits(covered)) undeclared_discard();
   }
@@ -387,7 +392,6 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
       const F out = live == 0xffu ? z : simd::select(f.live, z, stored);
       std::memcpy(depth_at, &out.p[0], sizeof out.p[0]);
     }
-    const I packed = f.has_rgba8 ? f.rgba8 : pack_rgba8<N>(f.color);
     if (live == 0xffu) {
       std::memcpy(color_at, &packed.p[0], sizeof packed.p[0]);
     } else {
@@ -403,7 +407,6 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
     (live == 0xffffu ? z : simd::select(f.live, z, stored)).store(depth_at);
   }
   if (blend_mode == BlendMode::kOpaque) {
-    const I packed = f.has_rgba8 ? f.rgba8 : pack_rgba8<N>(f.color);
     if (live == 0xffffu) {  // the common full block
       packed.store(color_at);
     } else {
@@ -413,8 +416,7 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   }
   if (f.has_rgba8) f.color = unpack_rgba8<N>(f.rgba8);
   I old = I::load(color_at);
-  I packed = blend<N>(blend_mode, f.color, old);
-  simd::select(f.live, packed, old).store(color_at);
+  simd::select(f.live, blend<N>(blend_mode, f.color, old), old).store(color_at);
 }
 
 // Where shade_mixed_wide's lanes find their triangles' plane coefficients: x_ref(), y_ref(),
@@ -587,11 +589,11 @@ SOFTRAST_SIMD_INLINE void shade_mixed_with(const S& shader, const ShadeTarget& t
   f.color = {F(0.0f), F(0.0f), F(0.0f), F(1.0f)};
   const uint32_t shaded = simd::bits(f.live);
   shader.template shade<N>(f);
+  const I packed = f.has_rgba8 ? f.rgba8 : pack_rgba8<N>(f.color);  // (as shade_block_wide)
   const uint32_t live = simd::bits(f.live);
   if (live != shaded) undeclared_discard();
   if (!target.resolved) simd::select(f.live, z, stored).store(depth_at);
   int32_t* color_at = reinterpret_cast<int32_t*>(fb.color_block(x, y));
-  I packed = f.has_rgba8 ? f.rgba8 : pack_rgba8<N>(f.color);
   if (live == 0xffffu) {
     packed.store(color_at);
     return;
