@@ -9,10 +9,10 @@ void BlockBatch::add(const Interpolants& in, int x, int y, uint32_t mask) {
     program_->shade_block(program_->shader, *target_, in, x, y, mask);
     return;
   }
-  hold(in, x, y, mask, index);
+  add_to_slot(in, x, y, mask, index);
 }
 
-void BlockBatch::hold(const Interpolants& in, int x, int y, uint32_t mask, int index) {
+void BlockBatch::add_to_slot(const Interpolants& in, int x, int y, uint32_t mask, int index) {
   Slot& slot = slots_[index];
   MixedBlock& held = slot.block;
   bool same_block = holds(index) && slot.x == x && slot.y == y;

@@ -55,10 +55,11 @@ class BlockBatch {
     return ((x >> 2) & (kSide - 1)) | ((y >> 2) & (kSide - 1)) * kSide;
   }
   bool holds(int slot) const { return (held_[slot >> 6] >> (slot & 63)) & 1u; }
-  // add's cases other than a whole block with nothing held, out of line: add is then a few
-  // tests and a jump to the fragment stage, without the six registers the other cases save and
-  // restore (24 instructions for a whole block, were 46).
-  [[gnu::noinline]] void hold(const Interpolants& in, int x, int y, uint32_t mask, int index);
+  // add's cases other than a whole block with nothing held (the block's slot is read or
+  // written), out of line: add is then a few tests and a jump to the fragment stage, without the
+  // six registers these cases save and restore (24 instructions for a whole block, were 46).
+  [[gnu::noinline]] void add_to_slot(const Interpolants& in, int x, int y, uint32_t mask,
+                                     int index);
   void shade(int slot);
 
   const FragmentProgram* program_ = nullptr;

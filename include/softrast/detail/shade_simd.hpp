@@ -372,7 +372,8 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   shader.template shade<N>(f);
   // The opaque output packed at once: f.color is dead from here. (Packed at the write, below,
   // the four vectors of f.color were kept across the rest, spilled where a shader's two output
-  // forms join: about 12 instructions a call of the texture shader's block.)
+  // forms join: about 20 instructions a call of the texture shader's blocks, quad_grid texture
+  // 396.8 M -> 388.8 M in three frames.)
   I packed{};
   if (blend_mode == BlendMode::kOpaque) packed = f.has_rgba8 ? f.rgba8 : pack_rgba8<N>(f.color);
   if constexpr (!DeclaresDiscards<S>) {
