@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -673,6 +674,85 @@ namespace {
 
 // pack_rgba8 (vectorised where SSE2 exists) against to_unorm8 per channel, the conventions'
 // x * 255 + 0.5 truncated after clamping, on every tie, both clamps, NaN and infinities.
+// ---------------------------------------------------------------------------------------------
+// The vertex stage of a draw that names few of its vertices.
+
+// Counts its calls per vertex; colours each vertex by its own varyings.
+struct NamedVerticesShader {
+  static constexpr int kVaryings = 3;
+  const glm::vec4* positions = nullptr;
+  const glm::vec3* colours = nullptr;
+  std::atomic<int>* calls = nullptr;  // per vertex
+  glm::vec4 vertex(uint32_t i, float* out) const {
+    ++calls[i];
+    out[0] = colours[i].r, out[1] = colours[i].g, out[2] = colours[i].b;
+    return positions[i];
+  }
+  template <int N>
+  SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
+    f.color = {f.varying(0), f.varying(1), f.varying(2), simd::Float<N>(1.0f)};
+  }
+};
+
+// One draw of a few triangles over a large vertex array (an OBJ material run, a glTF primitive)
+// runs the vertex shader once for each vertex it names and for no other (shading all of them
+// made many small draws quadratic), and draws what the same triangles draw when every vertex is
+// shaded: colour and depth bit for bit, with perspective (w from 0.5 to 4), the array's last
+// vertex and an out-of-range index among them.
+TEST(VertexStage, ADrawOfFewIndicesShadesOnlyTheVerticesItNames) {
+  constexpr int kWidth = 96, kHeight = 64;
+  constexpr uint32_t kVertices = 1000;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  std::vector<glm::vec4> positions;
+  std::vector<glm::vec3> colours;
+  for (uint32_t i = 0; i < kVertices; ++i) {
+    float w = 0.5f + 3.5f * unit(rng);
+    positions.push_back(
+        glm::vec4(2.0f * unit(rng) - 1.0f, 2.0f * unit(rng) - 1.0f, unit(rng), 1.0f) * w);
+    colours.push_back({unit(rng), unit(rng), unit(rng)});
+  }
+  std::uniform_int_distribution<uint32_t> any_vertex(0, kVertices - 1);
+  std::vector<uint32_t> indices;
+  for (int t = 0; t < 20; ++t) {
+    for (int k = 0; k < 3; ++k) indices.push_back(any_vertex(rng));
+  }
+  indices.insert(indices.end(), {kVertices - 1, 3, 500});  // the last vertex
+  indices.insert(indices.end(), {kVertices + 5, 10, 20});  // out of range: skipped
+  ASSERT_LT(indices.size(), size_t(kVertices));
+
+  RenderState state;
+  state.cull = CullMode::kNone;
+  state.threads = 2;
+  auto render = [&](std::span<const uint32_t> draw_indices, std::vector<std::atomic<int>>& calls) {
+    Framebuffer fb(kWidth, kHeight);
+    fb.clear();
+    NamedVerticesShader shader{positions.data(), colours.data(), calls.data()};
+    draw(fb, state, shader, draw_indices, kVertices);
+    return std::make_pair(fb.to_image(), fb.depth_values());
+  };
+
+  std::vector<std::atomic<int>> calls(kVertices);
+  auto [image, depth] = render(indices, calls);
+  std::set<uint32_t> named(indices.begin(), indices.end());
+  for (uint32_t i = 0; i < kVertices; ++i) {
+    ASSERT_EQ(calls[i].load(), named.count(i) ? 1 : 0) << "vertex " << i;
+  }
+
+  // The same triangles, padded with zero-area ones (which draw nothing) to as many indices as
+  // vertices: every vertex is shaded then.
+  std::vector<uint32_t> padded = indices;
+  padded.resize(kVertices, 0u);
+  std::vector<std::atomic<int>> all_calls(kVertices);
+  auto [reference_image, reference_depth] = render(padded, all_calls);
+  for (uint32_t i = 0; i < kVertices; ++i) ASSERT_EQ(all_calls[i].load(), 1) << "vertex " << i;
+  int drawn = 0;
+  for (float z : depth) drawn += z < 1.0f;
+  EXPECT_GT(drawn, kWidth * kHeight / 10);  // the triangles cover a good part of the image
+  EXPECT_EQ(image.rgba, reference_image.rgba);
+  EXPECT_EQ(depth, reference_depth);
+}
+
 TEST(ColourPacking, PackMatchesTheScalarConversionEverywhere) {
   std::vector<float> values = {0.0f,  1.0f,   -0.0f,         -1.0f,        2.0f,
                                1e30f, -1e30f, std::nanf(""), INFINITY,     -INFINITY,

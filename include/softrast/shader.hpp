@@ -71,8 +71,9 @@ concept ShaderProgram = requires(const S& s, uint32_t index, float* out) {
 };
 
 // Draws `indices` (three per triangle, two per line, one per point, as state.primitive says)
-// over vertices 0..vertex_count-1 into `framebuffer`. Runs the vertex shader once per vertex,
-// then clipping, culling, rasterization, depth test, the fragment shader and blending. Indices
+// over vertices 0..vertex_count-1 into `framebuffer`. Runs the vertex shader once per vertex
+// (only for the vertices the indices name when there are fewer indices than vertices), then
+// clipping, culling, rasterization, depth test, the fragment shader and blending. Indices
 // >= vertex_count skip their primitive; primitives with NaN or Inf positions draw nothing.
 // vertex() and fragment() may run on several threads at once (state.threads), so they must not
 // write to shared data; every pixel still sees the primitives in submission order.
@@ -81,6 +82,20 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
           std::span<const uint32_t> indices, uint32_t vertex_count) {
   constexpr int kStride = 4 + S::kVaryings;
   constexpr uint32_t kVerticesPerJob = 1024;
+  // A draw with fewer indices than vertices (one of many draws over a shared vertex array: an
+  // OBJ's material runs, a glTF scene's primitives) shades only the vertices it names,
+  // renumbered (detail::compact_draw): shading all of them in every draw made a scene of many
+  // small draws quadratic in its size (an OBJ of 32,000 one-triangle material runs took 41 s).
+  // Each vertex gets the same values either way, so the image is the same. Kept per thread and
+  // per shader type, as `clip` below.
+  thread_local std::vector<uint32_t> names, renumbered;
+  const uint32_t* name = nullptr;  // vertex k of this draw is the mesh's name[k] (null: k)
+  if (indices.size() < vertex_count) {
+    detail::compact_draw(indices, vertex_count, names, renumbered);
+    name = names.data();
+    vertex_count = uint32_t(names.size());
+    indices = renumbered;
+  }
   // The vertex stage's output, kept per thread and per shader type between draws: a scene drawn
   // again allocates nothing (the vector only grows; every element used is written below).
   thread_local std::vector<float> clip;
@@ -90,7 +105,7 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
     uint32_t end = uint32_t(std::min<size_t>(vertex_count, (job + 1) * kVerticesPerJob));
     for (uint32_t i = uint32_t(job * kVerticesPerJob); i < end; ++i) {
       float* v = out + size_t(i) * kStride;
-      glm::vec4 p = shader.vertex(i, v + 4);
+      glm::vec4 p = shader.vertex(name != nullptr ? name[i] : i, v + 4);
       v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = p.w;
     }
   };

@@ -127,6 +127,20 @@ void SerialDraw::point(const WindowVertex& w) {
 
 }  // namespace
 
+void compact_draw(std::span<const uint32_t> indices, uint32_t vertex_count,
+                  std::vector<uint32_t>& names, std::vector<uint32_t>& renumbered) {
+  names.assign(indices.begin(), indices.end());
+  std::sort(names.begin(), names.end());
+  names.erase(std::unique(names.begin(), names.end()), names.end());
+  names.erase(std::lower_bound(names.begin(), names.end(), vertex_count), names.end());
+  renumbered.resize(indices.size());
+  for (size_t i = 0; i < indices.size(); ++i) {
+    auto at = std::lower_bound(names.begin(), names.end(), indices[i]);
+    renumbered[i] =
+        at != names.end() && *at == indices[i] ? uint32_t(at - names.begin()) : 0xffffffffu;
+  }
+}
+
 void draw_clip_space(Framebuffer& framebuffer, const RenderState& state,
                      const ClipVertices& vertices, const uint32_t* indices, size_t index_count,
                      const FragmentProgram& program) {

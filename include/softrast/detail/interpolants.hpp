@@ -5,6 +5,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "softrast/render_state.hpp"
 
@@ -115,6 +117,12 @@ struct ClipVertices {
   int stride = 4;
   int num_varyings = 0;
 };
+
+// The vertices a draw's indices name: `names` gets the distinct indices below vertex_count, in
+// increasing order, and `renumbered` each index's place in `names` (in the order of `indices`;
+// an index >= vertex_count becomes 0xffffffff, still out of range). The vectors only grow.
+void compact_draw(std::span<const uint32_t> indices, uint32_t vertex_count,
+                  std::vector<uint32_t>& names, std::vector<uint32_t>& renumbered);
 
 // Runs primitive assembly, clipping, the divide, setup, rasterization and the fragment program
 // for one draw. Indices that are out of range skip their primitive.
