@@ -17,6 +17,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -70,9 +71,10 @@ std::string read_file(const fs::path& path) {
 }
 
 // Runs the program in `dir` (fork and exec, no shell) with stdout and stderr in files beside it;
-// kills it after `limit` seconds.
+// kills it after `limit` seconds. `file_bytes`: a limit on the size of the files it writes (as
+// `ulimit -f` sets), none when 0.
 Outcome run_cli(const fs::path& dir, const fs::path& logs, const std::vector<std::string>& args,
-                double limit) {
+                double limit, rlim_t file_bytes = 0) {
   std::vector<std::string> argv_text = {SOFTRAST_CLI_PATH};
   argv_text.insert(argv_text.end(), args.begin(), args.end());
   std::vector<char*> argv;
@@ -87,6 +89,10 @@ Outcome run_cli(const fs::path& dir, const fs::path& logs, const std::vector<std
     if (o < 0 || e < 0 || ::chdir(dir.c_str()) != 0) ::_exit(126);
     ::dup2(o, 1);
     ::dup2(e, 2);
+    if (file_bytes != 0) {
+      rlimit size{file_bytes, file_bytes};
+      if (::setrlimit(RLIMIT_FSIZE, &size) != 0) ::_exit(126);
+    }
     ::execv(argv[0], argv.data());
     ::_exit(127);
   }
@@ -576,10 +582,14 @@ std::vector<SignalCase> signal_cases() {
   return c;
 }
 
+const char* signal_name(int signal) {
+  return signal == SIGINT ? "SIGINT" : signal == SIGHUP ? "SIGHUP" : "SIGTERM";
+}
+
 TEST_F(HostileInput, SignalsEndTheProgramCleanly) {
   for (const SignalCase& c : signal_cases()) {
-    for (int signal : {SIGINT, SIGTERM}) {
-      std::string name = std::string(signal == SIGINT ? "SIGINT" : "SIGTERM") + " during " + c.name;
+    for (int signal : {SIGINT, SIGTERM, SIGHUP}) {
+      std::string name = std::string(signal_name(signal)) + " during " + c.name;
       SCOPED_TRACE(name);
       fs::path work = root_ / "work";
       fs::remove_all(work);
@@ -595,8 +605,7 @@ TEST_F(HostileInput, SignalsEndTheProgramCleanly) {
       ASSERT_EQ(std::count(r.outcome.err.begin(), r.outcome.err.end(), '\n'), 1)
           << "stderr: " << r.outcome.err;
       EXPECT_EQ(r.outcome.err.rfind("softrast: error: ", 0), 0u) << r.outcome.err;
-      EXPECT_NE(r.outcome.err.find(signal == SIGINT ? "SIGINT" : "SIGTERM"), std::string::npos)
-          << r.outcome.err;
+      EXPECT_NE(r.outcome.err.find(signal_name(signal)), std::string::npos) << r.outcome.err;
       EXPECT_FALSE(has_temporary_file(work)) << "a temporary file is left";
       EXPECT_FALSE(fs::exists(work / "out.png"));
       EXPECT_FALSE(fs::exists(work / "out.tga"));
@@ -616,6 +625,33 @@ TEST_F(HostileInput, SignalsEndTheProgramCleanly) {
       std::printf("hostile signal: %s: exit %d after %.2f s, %s", name.c_str(), r.outcome.exit_code,
                   r.seconds_after_signal, r.outcome.err.c_str());
     }
+  }
+}
+
+// Past a file-size limit (ulimit -f, a quota) the image's write fails as on a full disk: exit 1,
+// one error line that says why, no temporary file and no output. (By default the limit's signal,
+// SIGXFSZ, killed the program and left the temporary file.)
+TEST_F(HostileInput, AFileSizeLimitFailsTheWriteCleanly) {
+  constexpr rlim_t kLimit = 16 * 1024;
+  for (const std::string name : {"out.png", "out.tga", "out.jpg"}) {
+    SCOPED_TRACE(name);
+    fs::path work = root_ / "work";
+    fs::remove_all(work);
+    fs::create_directories(work);
+    // The demo scene at 1024x1024: every format's file is far above the limit.
+    Outcome r =
+        run_cli(work, root_ / "logs", {"-q", "--size", "1024x1024", "-o", name}, 60.0, kLimit);
+    EXPECT_FALSE(r.timed_out);
+    EXPECT_EQ(r.exit_code, 1) << "stderr: " << r.err;
+    ASSERT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "stderr: " << r.err;
+    EXPECT_EQ(r.err.rfind("softrast: error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(std::strerror(EFBIG)), std::string::npos) << r.err;
+    EXPECT_FALSE(has_temporary_file(work)) << "a temporary file is left";
+    EXPECT_FALSE(fs::exists(work / name));
+    // Without the limit the same image is written (the case is about the limit alone).
+    Outcome whole = run_cli(work, root_ / "logs", {"-q", "--size", "1024x1024", "-o", name}, 60.0);
+    EXPECT_EQ(whole.exit_code, 0) << whole.err;
+    EXPECT_GT(fs::file_size(work / name), 4 * kLimit);
   }
 }
 

@@ -1,8 +1,8 @@
 // apps/softrast/main.cpp: the softrast command line. Exit codes: 0 success, 1 runtime error
 // (files, memory, failed batch jobs), 2 usage error (flags); every error is one line
-// "softrast: error: ..." (here, and in batch, info and sequence through report.hpp). SIGINT and
-// SIGTERM still end it as signals, after removing any temporary image file and printing one
-// error line.
+// "softrast: error: ..." (here, and in batch, info and sequence through report.hpp). SIGINT,
+// SIGTERM and SIGHUP still end it as signals, after removing any temporary image file and
+// printing one error line; past a file-size limit the write fails as any failed write does.
 //
 //   softrast [render] [MODEL...] [-o out.png] [flags]     see `softrast --help`
 //   softrast batch JOBS.jsonl [--shard K/N]               see `softrast batch --help`
@@ -95,18 +95,22 @@ void describe(CLI::App& app, CLI::App& render) {
       "  softrast batch JOBS.jsonl [--shard K/N]   # one render per JSON line, resumable");
 }
 
-// SIGINT or SIGTERM: remove the temporary file of an image being written, then die of the signal
-// (SA_RESETHAND has restored the default action; the raised signal is delivered when the handler
-// returns), so the exit status still says which signal ended the program. Async-signal-safe.
-// One line on stderr says why the program stopped (write() only: async-signal-safe).
+// SIGINT, SIGTERM or SIGHUP (the terminal closed): remove the temporary file of an image being
+// written, then die of the signal (SA_RESETHAND has restored the default action; the raised
+// signal is delivered when the handler returns), so the exit status still says which signal ended
+// the program. One line on stderr says why the program stopped (write() only: async-signal-safe).
 void on_terminating_signal(int signal) {
   remove_pending_temporary_file();
   static constexpr char kInterrupt[] =
       "softrast: error: interrupted by SIGINT; no partial output file is left\n";
   static constexpr char kTerminate[] =
       "softrast: error: terminated by SIGTERM; no partial output file is left\n";
-  const char* line = signal == SIGINT ? kInterrupt : kTerminate;
-  size_t size = signal == SIGINT ? sizeof kInterrupt - 1 : sizeof kTerminate - 1;
+  static constexpr char kHangUp[] =
+      "softrast: error: hung up (SIGHUP); no partial output file is left\n";
+  const char* line = signal == SIGINT ? kInterrupt : signal == SIGHUP ? kHangUp : kTerminate;
+  size_t size = signal == SIGINT   ? sizeof kInterrupt - 1
+                : signal == SIGHUP ? sizeof kHangUp - 1
+                                   : sizeof kTerminate - 1;
   [[maybe_unused]] ssize_t written = write(STDERR_FILENO, line, size);
   raise(signal);
 }
@@ -118,6 +122,14 @@ void install_signal_handlers() {
   sigemptyset(&action.sa_mask);
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  sigaction(SIGHUP, &action, nullptr);
+  // A file-size limit (ulimit -f) reached while an image is written: SIGXFSZ ignored, the write
+  // fails with EFBIG instead and is reported as any failed write is, and the temporary file is
+  // removed (by default the signal killed the program and left it).
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGXFSZ, &ignore, nullptr);
 }
 
 // `softrast help [COMMAND]`: the help of COMMAND (default render, as `softrast --help`).
