@@ -118,7 +118,6 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
   program.writes_depth = detail::WritesDepth<S>;
   if constexpr (detail::WideShader<S>) {
     program.shade_block = detail::wide_shade_block<S>(simd_level());
-    program.shade_half = detail::wide_shade_half<S>(simd_level());
     program.deferrable = !detail::WritesDepth<S> && !detail::DeclaresDiscards<S>;
     if (program.deferrable && !detail::reads_derivatives(shader) && !detail::CheapToShade<S>) {
       program.shade_mixed = detail::wide_shade_mixed<S>(simd_level());

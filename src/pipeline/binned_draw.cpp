@@ -483,8 +483,6 @@ class BinnedDraw {
     if (scratch != nullptr && program_.shade_mixed != nullptr) {
       job.batch = &scratch->batch;
       job.batch->begin(program_, target_);
-    } else if (common_state(state_)) {
-      job.shade_half = program_.shade_half;
     }
     for (const Chunk& chunk : chunks()) {
       const std::vector<uint32_t>& bin = chunk.bins[tile];

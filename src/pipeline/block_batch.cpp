@@ -49,7 +49,8 @@ void BlockBatch::shade(int index) {
   Slot& slot = slots_[index];
   const MixedBlock& held = slot.block;
   if (held.count == 1) {
-    shade_block_call(*program_, half_, *target_, *held.winner[0], slot.x, slot.y, held.mask[0]);
+    program_->shade_block(program_->shader, *target_, *held.winner[0], slot.x, slot.y,
+                          held.mask[0]);
   } else {
     program_->shade_mixed(program_->shader, *target_, held, slot.x, slot.y);
   }

@@ -16,7 +16,6 @@
 
 #include <cstdint>
 
-#include "pipeline/shade_call.hpp"
 #include "raster/raster.hpp"
 #include "softrast/detail/interpolants.hpp"
 
@@ -34,7 +33,6 @@ class BlockBatch {
   void begin(const FragmentProgram& program, const ShadeTarget& target) {
     program_ = &program;
     target_ = &target;
-    half_ = target.resolved || common_state(*target.state) ? program.shade_half : nullptr;
   }
   // The pixels `mask` of the block at (x, y), covered by the triangle of `in`: held for a call
   // with other triangles' pixels of that block, or shaded now if they are the whole block (after
@@ -66,7 +64,6 @@ class BlockBatch {
 
   const FragmentProgram* program_ = nullptr;
   const ShadeTarget* target_ = nullptr;
-  ShadeBlockFn half_ = nullptr;  // for the blocks of one triangle (shade_block_call)
   // Which slots hold a block (count != 0): a whole block checks this, not its slot's 200 bytes,
   // and flush visits only these.
   uint64_t held_[kSide * kSide / 64] = {};

@@ -300,7 +300,7 @@ struct BlockTarget {
       if (job.batch != nullptr) {
         job.batch->add(rec.interp(), x, y, bits);
       } else {
-        shade_block_call(*job.program, job.shade_half, *job.target, rec.interp(), x, y, bits);
+        job.program->shade_block(job.program->shader, *job.target, rec.interp(), x, y, bits);
       }
     } else {
       TileVisibility& v = *job.visibility;

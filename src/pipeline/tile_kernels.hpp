@@ -13,7 +13,6 @@
 
 #include "core/prefetch.hpp"
 #include "pipeline/block_batch.hpp"
-#include "pipeline/shade_call.hpp"
 #include "pipeline/tile_visibility.hpp"
 #include "pipeline/triangle_record.hpp"
 #include "softrast/simd_level.hpp"
@@ -48,9 +47,6 @@ struct TileJob {
   const FragmentProgram* program = nullptr;
   const ShadeTarget* target = nullptr;
   BlockBatch* batch = nullptr;
-  // Without a batch: the blocks of which two rows are covered go here, when it is set
-  // (FragmentProgram::shade_half, for the common state).
-  ShadeBlockFn shade_half = nullptr;
   // Deferred: blocks go to the depth resolve; record k of the tile gets id next_id + k and its
   // interpolants in interps[id] (sized by the caller).
   TileVisibility* visibility = nullptr;

@@ -2,8 +2,6 @@
 // resolve kernels are in tile_kernel.inl).
 #include "pipeline/tile_visibility.hpp"
 
-#include "pipeline/shade_call.hpp"
-
 #include <emmintrin.h>
 
 #include <algorithm>
@@ -81,8 +79,7 @@ void shade_winners(const TileVisibility& vis, const Interpolants* const* interps
           int32_t winner = ids[__builtin_ctz(left)];
           uint32_t mask = lanes_equal(ids, winner);
           left &= ~mask;
-          shade_block_call(program, program.shade_half, resolved_target, *interps[winner], x, y,
-                           mask);
+          program.shade_block(program.shader, resolved_target, *interps[winner], x, y, mask);
         }
         continue;
       }
@@ -101,8 +98,8 @@ void shade_winners(const TileVisibility& vis, const Interpolants* const* interps
       for (int side = 0; side < 2; ++side) {
         MixedBlock& group = facing[side];
         if (group.count == 1) {
-          shade_block_call(program, program.shade_half, resolved_target, *group.winner[0], x, y,
-                           group.mask[0]);
+          program.shade_block(program.shader, resolved_target, *group.winner[0], x, y,
+                              group.mask[0]);
         } else if (group.count > 1) {
           group.front_facing = side == 1;
           program.shade_mixed(program.shader, resolved_target, group, x, y);

@@ -8,10 +8,9 @@
 #include <span>
 #include <vector>
 
-#include "softrast/render_state.hpp"
-
 namespace softrast {
 class Framebuffer;
+struct RenderState;
 }  // namespace softrast
 
 namespace softrast::detail {
@@ -95,19 +94,7 @@ struct FragmentProgram {
   bool deferrable = false;
   bool writes_depth = false;           // the shader sets the depth (late depth test)
   ShadeMixedFn shade_mixed = nullptr;  // deferrable shaders that read no derivatives in this draw
-  // AVX2 (a block is two registers of 8 lanes), a shader that does not write depth: a block of
-  // which only two rows are covered, shaded as shade_block would (the same bits), without its
-  // dispatch: rows y and y + 1 of the block whose top-left pixel is (x, y & ~3), `mask` their 8
-  // bits. Only for a resolved target or the common state (common_state). Null elsewhere.
-  ShadeBlockFn shade_half = nullptr;
 };
-
-// The state the fragment stage compiles with its branches resolved (shade_block_wide's
-// kCommon): depth test less with writes, opaque.
-inline bool common_state(const RenderState& st) {
-  return st.depth_test && st.depth_func == DepthFunc::kLess && st.depth_write &&
-         st.blend == BlendMode::kOpaque;
-}
 
 // The vertex stage's output: per vertex a clip-space position (x, y, z, w) followed by
 // `num_varyings` floats, `stride` floats apart.

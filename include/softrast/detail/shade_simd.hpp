@@ -621,7 +621,10 @@ SOFTRAST_SIMD_INLINE void shade_block_level(const void* shader, const ShadeTarge
   // The general variant alone (the same results; half the code to build and instrument).
   shade_block_wide<S, N, false>(s, target, interp, x, y, mask);
 #else
-  if ((!WritesDepth<S> && common_state(*target.state)) || target.resolved) {
+  const RenderState& st = *target.state;
+  bool common = !WritesDepth<S> && st.depth_test && st.depth_func == DepthFunc::kLess &&
+                st.depth_write && st.blend == BlendMode::kOpaque;
+  if (common || target.resolved) {
     if constexpr (simd::Float<N>::kParts == 2 && !WritesDepth<S>) {  // AVX2: halves alone
       if ((mask & 0xffu) == 0)
         return shade_block_wide<S, N, true, true>(s, target, interp, x, y + 2, mask >> 8);
@@ -655,15 +658,6 @@ template <class S>
                                                                 const Interpolants& interp, int x,
                                                                 int y, uint32_t mask) {
   shade_block_level<S, 8>(shader, target, interp, x, y, mask);
-}
-// FragmentProgram::shade_half at AVX2: the tile kernel calls it for its half blocks, which saves
-// shade_block_avx2's tests of the state and the mask and the stack frame its whole blocks need.
-template <class S>
-[[gnu::target("avx2,fma"), gnu::flatten]] void shade_half_avx2(const void* shader,
-                                                               const ShadeTarget& target,
-                                                               const Interpolants& interp, int x,
-                                                               int y, uint32_t mask) {
-  shade_block_wide<S, 8, true, true>(*static_cast<const S*>(shader), target, interp, x, y, mask);
 }
 template <class S>
 [[gnu::target("avx512f,avx512bw,avx512dq,avx512vl"), gnu::flatten]] void shade_block_avx512(
@@ -719,16 +713,6 @@ ShadeBlockFn wide_shade_block([[maybe_unused]] SimdLevel level) {
   }
   return &shade_block_sse2<S>;
 #endif
-}
-
-template <class S>
-ShadeBlockFn wide_shade_half([[maybe_unused]] SimdLevel level) {
-#if !defined(SOFTRAST_SHADERS_BASELINE_ONLY)
-  if constexpr (!WritesDepth<S>) {
-    if (level == SimdLevel::kAvx2) return &shade_half_avx2<S>;
-  }
-#endif
-  return nullptr;
 }
 
 template <class S>
