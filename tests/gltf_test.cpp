@@ -350,6 +350,18 @@ std::vector<BadCase> bad_cases() {
          return test::as_gltf(g);
        },
        "no triangles to draw: its 1 primitive is points or lines, which softrast does not draw"},
+      {"PositionsAsMatrices", "mat4.gltf",
+       [](GltfParts g, const std::string&) {
+         g.json["accessors"][0]["type"] = "MAT4";
+         return test::as_gltf(g);
+       },
+       "mesh 0 primitive 0: accessor 0: is MAT4 where VEC3 is expected"},
+      {"IndicesAsVectors", "vec3_indices.gltf",
+       [](GltfParts g, const std::string&) {
+         g.json["accessors"][3]["type"] = "VEC3";
+         return test::as_gltf(g);
+       },
+       "mesh 0 primitive 0: accessor 3: is VEC3 where SCALAR is expected"},
       {"CountOf2To31", "huge.gltf",
        [](GltfParts g, const std::string&) {
          g.json["accessors"][0]["count"] = 2147483648u;

@@ -50,6 +50,28 @@ int component_bytes(int type) {
   }
 }
 
+// The glTF name of an accessor type (tinygltf's code), for messages.
+std::string type_name(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR:
+      return "SCALAR";
+    case TINYGLTF_TYPE_VEC2:
+      return "VEC2";
+    case TINYGLTF_TYPE_VEC3:
+      return "VEC3";
+    case TINYGLTF_TYPE_VEC4:
+      return "VEC4";
+    case TINYGLTF_TYPE_MAT2:
+      return "MAT2";
+    case TINYGLTF_TYPE_MAT3:
+      return "MAT3";
+    case TINYGLTF_TYPE_MAT4:
+      return "MAT4";
+    default:
+      return "an unknown type";
+  }
+}
+
 int type_components(int type) {
   switch (type) {
     case TINYGLTF_TYPE_SCALAR:
@@ -131,7 +153,13 @@ Result<AccessorBytes> locate(const tg::Model& m, int index, const std::vector<in
   r.normalized = a.normalized;
   int bytes = component_bytes(a.componentType);
   if (std::find(allowed_types.begin(), allowed_types.end(), r.components) == allowed_types.end()) {
-    return fail(what, "has the wrong type for its use (" + n(uint64_t(a.type)) + ")");
+    // allowed_types: component counts, 1 to 4 (SCALAR, VEC2, VEC3, VEC4).
+    std::string expected;
+    for (int components : allowed_types) {
+      expected += (expected.empty() ? "" : " or ") +
+                  (components == 1 ? std::string("SCALAR") : "VEC" + std::to_string(components));
+    }
+    return fail(what, "is " + type_name(a.type) + " where " + expected + " is expected");
   }
   if (bytes == 0) return fail(what, "unknown componentType " + std::to_string(a.componentType));
   if (a.count > max_count) {
