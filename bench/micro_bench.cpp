@@ -239,6 +239,29 @@ BENCHMARK(BM_Draw)
     ->Args({0, 2})
     ->UseRealTime();
 
+// A scene of many small draws over one vertex array (an OBJ with a material per quad): the
+// fixed cost of a draw. Each draw once shaded the whole array's vertices, which made such scenes
+// quadratic in their size; `draws` quads of 1280x720, two threads.
+void BM_ManyDraws(benchmark::State& state) {
+  const int draws = int(state.range(0));
+  Mesh mesh = plane_grid(draws / 10, 10, false);
+  for (uint32_t quad = 0; quad < uint32_t(draws); ++quad) {
+    mesh.submeshes.push_back({quad * 6, 6, -1});
+  }
+  RenderOptions options;
+  options.shader = ShaderKind::kGouraud;
+  options.state.threads = 2;
+  Camera camera;
+  camera.eye = {0.0f, 0.0f, 0.9f / 0.4142f};
+  Framebuffer fb(1280, 720);
+  for (auto _ : state) {
+    fb.clear();
+    render_mesh(fb, mesh, camera, options);
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * draws);
+}
+BENCHMARK(BM_ManyDraws)->ArgName("draws")->Arg(1000)->Arg(10000)->UseRealTime();
+
 }  // namespace
 }  // namespace softrast
 
