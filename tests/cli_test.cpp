@@ -496,6 +496,19 @@ TEST_F(CliTest, MsaaNamesTheSampleCounts) {
   EXPECT_EQ(files(), kFixtures);
 }
 
+// --eye without --target at the model's centre (the default target: quad.obj's is the origin)
+// says so; it said "camera: near must be less than far".
+TEST_F(CliTest, EyeAtTheDefaultTargetSaysSo) {
+  CliRun r = run("quad.obj --eye 0,0,0 -o out.png");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err,
+            "softrast: error: --eye is at the default --target, the centre of the scene; give "
+            "--target, or another --eye\n");
+  EXPECT_EQ(files(), kFixtures);
+  CliRun moved = run("quad.obj --eye 0,0,0 --target 0,0,-1 -o out.png");  // looking away: empty
+  EXPECT_EQ(moved.exit_code, 0) << moved.err;
+}
+
 TEST_F(CliTest, HelpCommandPrintsTheHelp) {
   CliRun flag = run("--help");
   ASSERT_EQ(flag.exit_code, 0);

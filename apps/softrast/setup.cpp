@@ -361,6 +361,11 @@ Result<Scene> load_scene(const JobSpec& spec, const Loaders& loaders) {
   scene.load_ms = milliseconds_since(start);
   scene.name = scene_name(spec.models);
   scene.source = spec.models.empty() ? "demo scene" : joined(spec.models);
+  if (spec.camera.eye && !spec.camera.target && scene.camera.eye == scene.camera.target) {
+    return Status::error(
+        "--eye is at the default --target, the centre of the scene; give --target, or another "
+        "--eye");
+  }
   if (Status s = scene.camera.validate(); !s.ok()) return s;
   return scene;
 }

@@ -59,10 +59,10 @@ Status Camera::validate() const {
       !std::isfinite(near_plane) || !std::isfinite(far_plane)) {
     return Status::error("camera: every number must be finite");
   }
-  if (!(near_plane < far_plane)) return Status::error("camera: near must be less than far");
   // In double, as view(): squared lengths of float coordinates cannot overflow it.
   glm::dvec3 forward = glm::dvec3(target) - glm::dvec3(eye);
   if (glm::length(forward) == 0.0) return Status::error("camera: eye and target coincide");
+  if (!(near_plane < far_plane)) return Status::error("camera: near must be less than far");
   if (glm::length(glm::cross(forward, glm::dvec3(up))) <=
       1e-6 * glm::length(forward) * glm::length(glm::dvec3(up))) {
     return Status::error("camera: up is parallel to the view direction (or zero)");
