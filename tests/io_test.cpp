@@ -14,6 +14,7 @@
 #include <iterator>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -654,6 +655,23 @@ TEST_F(IoTest, ObjNumbersTinyobjOverflowedOnAreErrorsOrSkipped) {
   mesh = load_obj(path("e.obj"));
   ASSERT_FALSE(mesh.ok());
   EXPECT_EQ(mesh.status().message(), path("e.mtl") + ":2: number 1e39 is out of range");
+  // nan and inf, which tinyobj reads as 0 (a black Kd, an invisible d), as the OBJ's own are.
+  const std::pair<const char*, const char*> non_finite[] = {{"Kd 1 nan 0", "nan"},
+                                                            {"d nan", "nan"},
+                                                            {"Ns inf", "inf"},
+                                                            {"Ks -Infinity 0 0", "-Infinity"}};
+  for (const auto& [statement, word] : non_finite) {
+    write("e.mtl", std::string("newmtl a\n") + statement + "\n");
+    mesh = load_obj(path("e.obj"));
+    ASSERT_FALSE(mesh.ok()) << statement;
+    EXPECT_EQ(mesh.status().message(), path("e.mtl") + ":2: number " + std::string(word) +
+                                           " is not finite as a 32-bit float");
+  }
+  // A material named nan is a name, not a number.
+  write("e.mtl", "newmtl nan\nKd 1 0 0\n");
+  write("e.obj", std::string("mtllib e.mtl\n") + kQuadPositions + "usemtl nan\nf 1 2 3\n");
+  mesh = load_obj(path("e.obj"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
 }
 
 TEST_F(IoTest, ObjDevZeroFailsAtOnce) {

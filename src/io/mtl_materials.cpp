@@ -164,7 +164,18 @@ Status ObjMaterials::load_library(const std::string& name, const std::string& ob
   Status read = read_lines(
       path.string(), {max_bytes_, "MTL files"}, [&](std::string_view line, size_t number) {
         ObjWords words(line);
-        for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
+        // The numbers of a colour or scalar statement: tinyobj reads nan and inf as 0 (a black
+        // Kd, an invisible d), so they are refused here as the OBJ's own numbers are.
+        const std::string_view key = words.next();
+        const bool numeric = key == "Ka" || key == "Kd" || key == "Ks" || key == "Ke" ||
+                             key == "Tf" || key == "Ns" || key == "Ni" || key == "d" || key == "Tr";
+        for (std::string_view w = key; !w.empty(); w = words.next()) {
+          float value = 0.0f;
+          if (numeric && w != key && w.find_first_of("nN") != w.npos &&
+              parse_obj_float(w, value) == ObjNumber::kOutOfRange) {
+            return fail_at(path.string(), number,
+                           "number " + std::string(w) + " is not finite as a 32-bit float");
+          }
           if (mtl_number_out_of_range(w)) {
             return fail_at(path.string(), number, "number " + std::string(w) + " is out of range");
           }
