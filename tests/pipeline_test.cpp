@@ -698,7 +698,7 @@ struct NamedVerticesShader {
 // runs the vertex shader once for each vertex it names and for no other (shading all of them
 // made many small draws quadratic), and draws what the same triangles draw when every vertex is
 // shaded: colour and depth bit for bit, with perspective (w from 0.5 to 4), the array's last
-// vertex and an out-of-range index among them.
+// vertex and an out-of-range index among them, for two draws in a row.
 TEST(VertexStage, ADrawOfFewIndicesShadesOnlyTheVerticesItNames) {
   constexpr int kWidth = 96, kHeight = 64;
   constexpr uint32_t kVertices = 1000;
@@ -713,14 +713,6 @@ TEST(VertexStage, ADrawOfFewIndicesShadesOnlyTheVerticesItNames) {
     colours.push_back({unit(rng), unit(rng), unit(rng)});
   }
   std::uniform_int_distribution<uint32_t> any_vertex(0, kVertices - 1);
-  std::vector<uint32_t> indices;
-  for (int t = 0; t < 20; ++t) {
-    for (int k = 0; k < 3; ++k) indices.push_back(any_vertex(rng));
-  }
-  indices.insert(indices.end(), {kVertices - 1, 3, 500});  // the last vertex
-  indices.insert(indices.end(), {kVertices + 5, 10, 20});  // out of range: skipped
-  ASSERT_LT(indices.size(), size_t(kVertices));
-
   RenderState state;
   state.cull = CullMode::kNone;
   state.threads = 2;
@@ -732,25 +724,37 @@ TEST(VertexStage, ADrawOfFewIndicesShadesOnlyTheVerticesItNames) {
     return std::make_pair(fb.to_image(), fb.depth_values());
   };
 
-  std::vector<std::atomic<int>> calls(kVertices);
-  auto [image, depth] = render(indices, calls);
-  std::set<uint32_t> named(indices.begin(), indices.end());
-  for (uint32_t i = 0; i < kVertices; ++i) {
-    ASSERT_EQ(calls[i].load(), named.count(i) ? 1 : 0) << "vertex " << i;
-  }
+  // Two draws one after the other (the second's vertices partly the first's), each against the
+  // same triangles padded with zero-area ones (which draw nothing) to as many indices as
+  // vertices, so that every vertex is shaded.
+  for (int pass = 0; pass < 2; ++pass) {
+    SCOPED_TRACE(pass == 0 ? "first draw" : "second draw");
+    std::vector<uint32_t> indices;
+    for (int t = 0; t < 20; ++t) {
+      for (int k = 0; k < 3; ++k) indices.push_back(any_vertex(rng));
+    }
+    indices.insert(indices.end(), {kVertices - 1, 3, 500});  // the last vertex
+    indices.insert(indices.end(), {kVertices + 5, 10, 20});  // out of range: skipped
+    ASSERT_LT(indices.size(), size_t(kVertices));
 
-  // The same triangles, padded with zero-area ones (which draw nothing) to as many indices as
-  // vertices: every vertex is shaded then.
-  std::vector<uint32_t> padded = indices;
-  padded.resize(kVertices, 0u);
-  std::vector<std::atomic<int>> all_calls(kVertices);
-  auto [reference_image, reference_depth] = render(padded, all_calls);
-  for (uint32_t i = 0; i < kVertices; ++i) ASSERT_EQ(all_calls[i].load(), 1) << "vertex " << i;
-  int drawn = 0;
-  for (float z : depth) drawn += z < 1.0f;
-  EXPECT_GT(drawn, kWidth * kHeight / 10);  // the triangles cover a good part of the image
-  EXPECT_EQ(image.rgba, reference_image.rgba);
-  EXPECT_EQ(depth, reference_depth);
+    std::vector<std::atomic<int>> calls(kVertices);
+    auto [image, depth] = render(indices, calls);
+    std::set<uint32_t> named(indices.begin(), indices.end());
+    for (uint32_t i = 0; i < kVertices; ++i) {
+      ASSERT_EQ(calls[i].load(), named.count(i) ? 1 : 0) << "vertex " << i;
+    }
+
+    std::vector<uint32_t> padded = indices;
+    padded.resize(kVertices, 0u);
+    std::vector<std::atomic<int>> all_calls(kVertices);
+    auto [reference_image, reference_depth] = render(padded, all_calls);
+    for (uint32_t i = 0; i < kVertices; ++i) ASSERT_EQ(all_calls[i].load(), 1) << "vertex " << i;
+    int drawn = 0;
+    for (float z : depth) drawn += z < 1.0f;
+    EXPECT_GT(drawn, kWidth * kHeight / 10);  // the triangles cover a good part of the image
+    EXPECT_EQ(image.rgba, reference_image.rgba);
+    EXPECT_EQ(depth, reference_depth);
+  }
 }
 
 TEST(ColourPacking, PackMatchesTheScalarConversionEverywhere) {

@@ -128,17 +128,27 @@ void SerialDraw::point(const WindowVertex& w) {
 }  // namespace
 
 void compact_draw(std::span<const uint32_t> indices, uint32_t vertex_count,
-                  std::vector<uint32_t>& names, std::vector<uint32_t>& renumbered) {
-  names.assign(indices.begin(), indices.end());
-  std::sort(names.begin(), names.end());
-  names.erase(std::unique(names.begin(), names.end()), names.end());
-  names.erase(std::lower_bound(names.begin(), names.end(), vertex_count), names.end());
+                  std::vector<uint32_t>& names, std::vector<uint32_t>& renumbered,
+                  std::vector<uint32_t>& place) {
+  // Everything allocated first: `place` must be all zeros again when this returns.
+  names.clear();
+  names.reserve(indices.size());
   renumbered.resize(indices.size());
-  for (size_t i = 0; i < indices.size(); ++i) {
-    auto at = std::lower_bound(names.begin(), names.end(), indices[i]);
-    renumbered[i] =
-        at != names.end() && *at == indices[i] ? uint32_t(at - names.begin()) : 0xffffffffu;
+  if (place.size() < vertex_count) place.resize(vertex_count, 0u);
+  for (size_t k = 0; k < indices.size(); ++k) {
+    const uint32_t i = indices[k];
+    if (i >= vertex_count) {
+      renumbered[k] = 0xffffffffu;
+      continue;
+    }
+    uint32_t& p = place[i];
+    if (p == 0) {
+      names.push_back(i);
+      p = uint32_t(names.size());
+    }
+    renumbered[k] = p - 1;
   }
+  for (uint32_t i : names) place[i] = 0;
 }
 
 void draw_clip_space(Framebuffer& framebuffer, const RenderState& state,
