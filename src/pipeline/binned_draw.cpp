@@ -50,6 +50,11 @@ static_assert(Framebuffer::kTileSize == kTileSize && Framebuffer::kBlockSize == 
 constexpr size_t kBatchTriangles = 32768;
 // Chunks per thread in the geometry phase, for load balance when clipping is uneven.
 constexpr int kChunksPerThread = 4;
+// The fewest triangles a chunk takes: a draw of few triangles gets fewer chunks (one below 256).
+// Every chunk clears and every raster phase reads each tile's bin of every chunk, a fixed cost
+// per draw that made eight chunks of a one-triangle draw cost more than its triangle (a scene of
+// 10,000 such draws).
+constexpr size_t kMinChunkTriangles = 256;
 
 // Cache-line aligned: each chunk's arena and bins are written by one thread while neighbours are
 // written by others.
@@ -116,7 +121,7 @@ class BinnedDraw {
     const PixelRect& s = geometry.scissor();
     tiles_x_ = (s.x1 + kTileSize - 1) / kTileSize;
     tiles_y_ = (s.y1 + kTileSize - 1) / kTileSize;
-    num_chunks_ = threads == 1 ? 1 : size_t(threads) * kChunksPerThread;
+    max_chunks_ = threads == 1 ? 1 : size_t(threads) * kChunksPerThread;
     if (TileTimes* t = state.tile_times; t && (t->tiles_x != tiles_x_ || t->tiles_y != tiles_y_)) {
       t->tiles_x = tiles_x_;
       t->tiles_y = tiles_y_;
@@ -135,6 +140,9 @@ class BinnedDraw {
     // One thread, or one batch, gains nothing from it: setup, then raster.
     const bool overlap = threads_ > 1 && batches > 1;
     const size_t sets = overlap ? 2 : 1;
+    num_chunks_ = std::clamp<size_t>(
+        (std::min(triangles, kBatchTriangles) + kMinChunkTriangles - 1) / kMinChunkTriangles, 1,
+        max_chunks_);
     // The cache keeps the most chunks any draw used (one thread needs one), so alternating
     // thread counts does not free and reallocate arenas.
     if (cache_.chunks.size() < sets * num_chunks_) cache_.chunks.resize(sets * num_chunks_);
@@ -554,7 +562,8 @@ class BinnedDraw {
   TriangleKernel triangle_kernel_{};
   bool scanline_ = false;  // records hold their vertices (RasterAlgorithm::kScanline)
   size_t record_bytes_ = 0;
-  size_t num_chunks_ = 1;
+  size_t max_chunks_ = 1;  // the threads' chunks (kChunksPerThread each)
+  size_t num_chunks_ = 1;  // this draw's: fewer for few triangles (kMinChunkTriangles)
   const Chunk* raster_chunks_ = nullptr;  // the half of the chunks phase 2 reads
   int tiles_x_ = 0, tiles_y_ = 0;
 };
