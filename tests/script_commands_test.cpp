@@ -255,15 +255,16 @@ TEST_F(ScriptTest, BadJobsFailAloneWithTheirLineNumbers) {
         "{\"model\": \"quad.obj\", \"output\": \"frames.png\", \"frames\": 3}\n"         // 9
         "[1, 2]\n"                                                                       // 10
         "{\"model\": \"quad.obj\", \"output\": \"flag.png\", \"wireframe\": \"yes\"}\n"  // 11
-        "{\"model\": \"quad.obj\", \"output\": \"good2.png\", \"size\": \"32x32\"}\n");  // 12
+        "{\"model\": \"quad.obj\", \"output\": \"\"}\n"                                  // 12
+        "{\"model\": \"quad.obj\", \"output\": \"good2.png\", \"size\": \"32x32\"}\n");  // 13
   Outcome r = run("batch jobs.jsonl");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(summary(r.err), "batch: 2 rendered, 0 skipped, 10 failed");
+  EXPECT_EQ(summary(r.err), "batch: 2 rendered, 0 skipped, 11 failed");
   std::vector<std::string> errors;
   for (const std::string& line : lines_of(r.err)) {
     if (line.rfind("softrast: error: ", 0) == 0) errors.push_back(line.substr(17));
   }
-  ASSERT_EQ(errors.size(), 10u) << r.err;
+  ASSERT_EQ(errors.size(), 11u) << r.err;
   auto starts = [](const std::string& text, const std::string& prefix) {
     return text.rfind(prefix, 0) == 0;
   };
@@ -277,6 +278,7 @@ TEST_F(ScriptTest, BadJobsFailAloneWithTheirLineNumbers) {
   EXPECT_TRUE(starts(errors[7], "jobs.jsonl:9: \"frames\" has no place in a job")) << errors[7];
   EXPECT_EQ(errors[8], "jobs.jsonl:10: a job must be a JSON object {...}");
   EXPECT_EQ(errors[9], "jobs.jsonl:11: \"wireframe\": expected true or false, got \"yes\"");
+  EXPECT_EQ(errors[10], "jobs.jsonl:12: \"output\" is empty: every job names the image it writes");
   std::set<std::string> files;
   for (const auto& e : fs::directory_iterator(work())) files.insert(e.path().filename().string());
   EXPECT_EQ(files, (std::set<std::string>{"quad.obj", "cube.obj", "texture.png", "jobs.jsonl",

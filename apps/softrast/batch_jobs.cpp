@@ -191,6 +191,10 @@ Result<std::vector<std::string>> job_words(const json& job, const CLI::App& app)
       s = add_models(value, models);
     } else if (key == kOutputKey) {
       if (!value.is_string()) return wrong_kind(key, value, "a path");
+      // (An empty path made "--out=" take the "--" that follows as the path.)
+      if (value.get<std::string>().empty()) {
+        return Status::error("\"output\" is empty: every job names the image it writes");
+      }
       flags.push_back("--out=" + value.get<std::string>());
     } else {
       s = add_flag(app, key, value, flags);
