@@ -88,10 +88,10 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
   // small draws quadratic in its size (an OBJ of 32,000 one-triangle material runs took 41 s).
   // Each vertex gets the same values either way, so the image is the same. Kept per thread and
   // per shader type, as `clip` below.
-  thread_local std::vector<uint32_t> names, renumbered, place;
+  thread_local std::vector<uint32_t> names, renumbered;
   const uint32_t* name = nullptr;  // vertex k of this draw is the mesh's name[k] (null: k)
   if (indices.size() < vertex_count) {
-    detail::compact_draw(indices, vertex_count, names, renumbered, place);
+    detail::compact_draw(indices, vertex_count, names, renumbered);
     name = names.data();
     vertex_count = uint32_t(names.size());
     indices = renumbered;

@@ -128,8 +128,10 @@ void SerialDraw::point(const WindowVertex& w) {
 }  // namespace
 
 void compact_draw(std::span<const uint32_t> indices, uint32_t vertex_count,
-                  std::vector<uint32_t>& names, std::vector<uint32_t>& renumbered,
-                  std::vector<uint32_t>& place) {
+                  std::vector<uint32_t>& names, std::vector<uint32_t>& renumbered) {
+  // Each vertex's place in `names` plus one (0: not named yet), all zeros between calls; one
+  // array per thread whatever the shader type (it grows to the largest vertex count drawn).
+  thread_local std::vector<uint32_t> place;
   // Everything allocated first: `place` must be all zeros again when this returns.
   names.clear();
   names.reserve(indices.size());

@@ -107,13 +107,11 @@ struct ClipVertices {
 
 // The vertices a draw's indices name: `names` gets the distinct indices below vertex_count, in
 // the order they first appear, and `renumbered` each index's place in `names` (in the order of
-// `indices`; an index >= vertex_count becomes 0xffffffff, still out of range). `place` is
-// scratch of one entry per vertex, all zeros before and after (it grows to vertex_count). In
-// time linear in the indices: a sort made a draw of 30,000 indices cost more than shading a
-// 120,000-vertex array. The vectors only grow.
+// `indices`; an index >= vertex_count becomes 0xffffffff, still out of range). In time linear in
+// the indices (a sort made a draw of 30,000 indices cost more than shading a 120,000-vertex
+// array), with a scratch array of one entry per vertex kept per thread. The vectors only grow.
 void compact_draw(std::span<const uint32_t> indices, uint32_t vertex_count,
-                  std::vector<uint32_t>& names, std::vector<uint32_t>& renumbered,
-                  std::vector<uint32_t>& place);
+                  std::vector<uint32_t>& names, std::vector<uint32_t>& renumbered);
 
 // Runs primitive assembly, clipping, the divide, setup, rasterization and the fragment program
 // for one draw. Indices that are out of range skip their primitive.
