@@ -212,16 +212,12 @@ Mesh plane_grid(int columns, int rows, bool reversed) {
   return mesh;
 }
 
-// Whole draws of 230 k triangles of about 4 pixels at 1280x720: the front end alone (vertex
-// shading, clipping, setup and culling: every triangle is back-facing), then everything
-// (binning, coverage, deferred Gouraud shading), by threads.
-void BM_Draw(benchmark::State& state) {
-  bool front_end_only = state.range(0) != 0;
-  static const Mesh visible = plane_grid(320, 360, false), culled = plane_grid(320, 360, true);
-  const Mesh& mesh = front_end_only ? culled : visible;
+// The benchmark's frames: `mesh` cleared and drawn with Gouraud shading at 1280x720 on `threads`
+// threads, the camera on +z framing plane_grid's 3.2 x 1.8 plane.
+void render_frames(benchmark::State& state, const Mesh& mesh, int threads) {
   RenderOptions options;
   options.shader = ShaderKind::kGouraud;
-  options.state.threads = int(state.range(1));
+  options.state.threads = threads;
   Camera camera;
   camera.eye = {0.0f, 0.0f, 0.9f / 0.4142f};
   Framebuffer fb(1280, 720);
@@ -229,6 +225,16 @@ void BM_Draw(benchmark::State& state) {
     fb.clear();
     render_mesh(fb, mesh, camera, options);
   }
+}
+
+// Whole draws of 230 k triangles of about 4 pixels at 1280x720: the front end alone (vertex
+// shading, clipping, setup and culling: every triangle is back-facing), then everything
+// (binning, coverage, deferred Gouraud shading), by threads.
+void BM_Draw(benchmark::State& state) {
+  bool front_end_only = state.range(0) != 0;
+  static const Mesh visible = plane_grid(320, 360, false), culled = plane_grid(320, 360, true);
+  const Mesh& mesh = front_end_only ? culled : visible;
+  render_frames(state, mesh, int(state.range(1)));
   state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(mesh.triangle_count()));
 }
 BENCHMARK(BM_Draw)
@@ -248,16 +254,7 @@ void BM_ManyDraws(benchmark::State& state) {
   for (uint32_t quad = 0; quad < uint32_t(draws); ++quad) {
     mesh.submeshes.push_back({quad * 6, 6, -1});
   }
-  RenderOptions options;
-  options.shader = ShaderKind::kGouraud;
-  options.state.threads = 2;
-  Camera camera;
-  camera.eye = {0.0f, 0.0f, 0.9f / 0.4142f};
-  Framebuffer fb(1280, 720);
-  for (auto _ : state) {
-    fb.clear();
-    render_mesh(fb, mesh, camera, options);
-  }
+  render_frames(state, mesh, 2);
   state.SetItemsProcessed(int64_t(state.iterations()) * draws);
 }
 BENCHMARK(BM_ManyDraws)->ArgName("draws")->Arg(1000)->Arg(10000)->UseRealTime();
