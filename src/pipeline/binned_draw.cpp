@@ -223,8 +223,9 @@ class BinnedDraw {
         // The varyings of the group after next, prefetched: the kernel reads them late in its
         // work, each vertex's from wherever its index points, and a miss there stalled the
         // group (spheres_1m gouraud, one thread, AVX-512: 32.4 -> 27.4 ms a frame). The window
-        // vertices, read first, gain nothing from it.
-        if (const size_t ahead = t + kPrefetchGroups * width; ahead < end) {
+        // vertices, read first, gain nothing from it. (A draw without varyings has none to fetch.)
+        if (const size_t ahead = t + kPrefetchGroups * width;
+            batch.num_varyings > 0 && ahead < end) {
           const uint32_t* ahead_indices = indices + 3 * ahead;
           const size_t m = 3 * std::min(width, end - ahead);
           for (size_t j = 0; j < m; j += kPrefetchStep) {
