@@ -542,8 +542,9 @@ template <Mode kMode>
 // Asks the cache for the record kRecordPrefetchAhead places on in the bin: a batch's records
 // outgrow the L2 cache, and a tile reads its own among those of its neighbours, so each was a miss
 // to L3 when the raster reached it (spheres_1m: a sixth of the tile kernel's time on the record's
-// first load). Four lines: the coverage and the first planes (a record of three varyings is 184
-// bytes, of phong's six 224; a fifth line for phong's measured the same).
+// first load). Four lines: the coverage and the first planes (a record of three varyings is 192
+// bytes, of phong's six 232; a fifth line for phong's measured the same). Eight records ahead
+// measured the same as four on a Zen 5 (spheres_1m, one thread).
 constexpr size_t kRecordPrefetchAhead = 4;
 [[gnu::always_inline]] inline void prefetch_record(const std::byte* record) {
   for (int line = 0; line < 4; ++line) {
