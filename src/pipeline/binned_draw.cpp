@@ -230,7 +230,7 @@ class BinnedDraw {
           const size_t m = 3 * std::min(width, end - ahead);
           for (size_t j = 0; j < m; j += kPrefetchStep) {
             if (ahead_indices[j] < n) {
-              __builtin_prefetch(batch.varyings + size_t(ahead_indices[j]) * batch.stride);
+              prefetch_line(batch.varyings + size_t(ahead_indices[j]) * batch.stride);
             }
           }
         }
