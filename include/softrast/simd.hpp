@@ -80,6 +80,8 @@ SOFTRAST_AVX512 void blend(const I16& mask, const F16& a, const F16& b, F16& r);
 SOFTRAST_AVX512 void blend(const I16& mask, const I16& a, const I16& b, I16& r);
 SOFTRAST_AVX512 void broadcast(float s, F16& r);
 SOFTRAST_AVX512 void broadcast(int32_t s, I16& r);
+SOFTRAST_AVX512 void store_lanes(uint32_t bits, const F16& v, float* to);
+SOFTRAST_AVX512 void store_lanes(uint32_t bits, const I16& v, int32_t* to);
 // AVX2's broadcasts, one VBROADCASTSS or VPBROADCASTD (the shuffle of lane 0 below is a move into
 // a zeroed register, a move to clear the upper lanes again and then the broadcast).
 using F8 = float __attribute__((vector_size(32)));
@@ -291,6 +293,20 @@ SOFTRAST_SIMD_INLINE Int<N> select(const Int<N>& mask, const Int<N>& a, const In
   return r;
 }
 
+// Lane i of `v` to to[i] where bit i of `bits` is set, the other elements of `to` untouched: one
+// masked store. AVX-512 only: its masked stores are fast, AVX2's are slow on AMD's Zen 3 (see
+// core/store_mode.hpp), where a blend into the loaded values and a whole store do the same.
+template <int N>
+SOFTRAST_SIMD_INLINE void store_lanes(uint32_t bits, const Float<N>& v, float* to) {
+  static_assert(N == 16);
+  isa::store_lanes(bits, v.p[0], to);
+}
+template <int N>
+SOFTRAST_SIMD_INLINE void store_lanes(uint32_t bits, const Int<N>& v, int32_t* to) {
+  static_assert(N == 16);
+  isa::store_lanes(bits, v.p[0], to);
+}
+
 // min/max with the SSE semantics (and std::min/std::max's): the second operand when either is
 // NaN, so max(NaN, 0) is 0.
 // (One instruction each, defined with the helpers below.)
@@ -423,6 +439,12 @@ SOFTRAST_AVX512 void broadcast(int32_t s, I16& r) {
 }
 SOFTRAST_AVX512 void blend(const I16& mask, const I16& a, const I16& b, I16& r) {
   r = I16(_mm512_mask_blend_epi32(_mm512_movepi32_mask(__m512i(mask)), __m512i(b), __m512i(a)));
+}
+SOFTRAST_AVX512 void store_lanes(uint32_t bits, const F16& v, float* to) {
+  _mm512_mask_storeu_ps(to, __mmask16(bits), __m512(v));
+}
+SOFTRAST_AVX512 void store_lanes(uint32_t bits, const I16& v, int32_t* to) {
+  _mm512_mask_storeu_epi32(to, __mmask16(bits), __m512i(v));
 }
 
 inline void sqrt(const Native<4>::F& a, Native<4>::F& r) {
