@@ -293,18 +293,31 @@ SOFTRAST_SIMD_INLINE Int<N> select(const Int<N>& mask, const Int<N>& a, const In
   return r;
 }
 
-// Lane i of `v` to to[i] where bit i of `bits` is set, the other elements of `to` untouched: one
-// masked store. AVX-512 only: its masked stores are fast, AVX2's are slow on AMD's Zen 3 (see
-// core/store_mode.hpp), where a blend into the loaded values and a whole store do the same.
+// Lane i of `v` to to[i] where lane i of `mask` is set (`bits`: its lanes as bits, simd::bits),
+// the other elements of `to` untouched. At AVX-512 one masked store; elsewhere a whole store for
+// all 16 lanes, else a blend into the values loaded and a whole store (AVX2's masked stores are
+// slow on AMD's Zen 3: core/store_mode.hpp).
 template <int N>
-SOFTRAST_SIMD_INLINE void store_lanes(uint32_t bits, const Float<N>& v, float* to) {
-  static_assert(N == 16);
-  isa::store_lanes(bits, v.p[0], to);
+SOFTRAST_SIMD_INLINE void store_lanes(const Int<N>& mask, uint32_t bits, const Float<N>& v,
+                                      float* to) {
+  if constexpr (N == 16) {
+    isa::store_lanes(bits, v.p[0], to);
+  } else if (bits == 0xffffu) {
+    v.store(to);
+  } else {
+    select(mask, v, Float<N>::load(to)).store(to);
+  }
 }
 template <int N>
-SOFTRAST_SIMD_INLINE void store_lanes(uint32_t bits, const Int<N>& v, int32_t* to) {
-  static_assert(N == 16);
-  isa::store_lanes(bits, v.p[0], to);
+SOFTRAST_SIMD_INLINE void store_lanes(const Int<N>& mask, uint32_t bits, const Int<N>& v,
+                                      int32_t* to) {
+  if constexpr (N == 16) {
+    isa::store_lanes(bits, v.p[0], to);
+  } else if (bits == 0xffffu) {
+    v.store(to);
+  } else {
+    select(mask, v, Int<N>::load(to)).store(to);
+  }
 }
 
 // min/max with the SSE semantics (and std::min/std::max's): the second operand when either is

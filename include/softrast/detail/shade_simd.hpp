@@ -404,27 +404,13 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
     }
     return;
   }
-  if constexpr (N == 16) {
-    // AVX-512: the live lanes by masked stores, so that `stored` is dead after the early test
-    // (kept for a blend here, GCC spilled it and reloaded it around the test: about 1 % of
-    // quad_grid's and diablo3's time).
-    if (depth_test && depth_write) simd::store_lanes(live, z, depth_at);
-    if (blend_mode == BlendMode::kOpaque) {
-      simd::store_lanes(live, packed, color_at);
-      return;
-    }
-  } else {
-    if (depth_test && depth_write) {
-      (live == 0xffffu ? z : simd::select(f.live, z, stored)).store(depth_at);
-    }
-    if (blend_mode == BlendMode::kOpaque) {
-      if (live == 0xffffu) {  // the common full block
-        packed.store(color_at);
-      } else {
-        simd::select(f.live, packed, I::load(color_at)).store(color_at);
-      }
-      return;
-    }
+  // The live lanes only (simd::store_lanes: masked stores at AVX-512, where blending into the
+  // loaded depth kept `stored` live across the shader, spilled and reloaded around the early test:
+  // about 1 % of quad_grid's and diablo3's time).
+  if (depth_test && depth_write) simd::store_lanes(f.live, live, z, depth_at);
+  if (blend_mode == BlendMode::kOpaque) {
+    simd::store_lanes(f.live, live, packed, color_at);
+    return;
   }
   if (f.has_rgba8) f.color = unpack_rgba8<N>(f.rgba8);
   I old = I::load(color_at);
@@ -605,17 +591,8 @@ SOFTRAST_SIMD_INLINE void shade_mixed_with(const S& shader, const ShadeTarget& t
   const uint32_t live = simd::bits(f.live);
   if (live != shaded) undeclared_discard();
   int32_t* color_at = reinterpret_cast<int32_t*>(fb.color_block(x, y));
-  if constexpr (N == 16) {  // masked stores (as shade_block_wide)
-    if (!target.resolved) simd::store_lanes(live, z, depth_at);
-    simd::store_lanes(live, packed, color_at);
-    return;
-  }
-  if (!target.resolved) simd::select(f.live, z, stored).store(depth_at);
-  if (live == 0xffffu) {
-    packed.store(color_at);
-    return;
-  }
-  simd::select(f.live, packed, I::load(color_at)).store(color_at);
+  if (!target.resolved) simd::store_lanes(f.live, live, z, depth_at);
+  simd::store_lanes(f.live, live, packed, color_at);
 }
 
 template <class S, int N>
