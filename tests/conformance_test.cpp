@@ -202,7 +202,7 @@ struct ConformShader {
         f.color = {f.varying(0), f.varying(1), f.varying(2), f.varying(3)};
         break;
       case Mode::kTexture: {
-        simd::Vec4<N> t = detail::sample_with_derivatives(*texture, sampler, f, 4);
+        simd::Vec4<N> t = detail::sample_with_derivatives(SampledTexture(*texture, sampler), f, 4);
         f.color = {t.x, t.y, t.z, t.w};
         break;
       }

@@ -121,27 +121,36 @@ void expect_sampler_matches_scalar(const Texture& texture, const Sampler& sample
       dy.x.set_lane(i, test_ddy(first + i).x);
       dy.y.set_lane(i, test_ddy(first + i).y);
     }
-    simd::Vec4<N> got = sampler.filter == Filter::kTrilinear
-                            ? sample<N>(texture, sampler, uv, dx, dy)
-                            : sample<N>(texture, sampler, uv);
-    for (int i = 0; i < simd::kLanes; ++i) {
-      glm::vec4 want =
-          sampler.filter == Filter::kTrilinear
-              ? texture.sample(sampler, uvs[first + i], test_ddx(first + i), test_ddy(first + i))
-              : texture.sample(sampler, uvs[first + i]);
-      ASSERT_EQ(got.x.lane(i), want.r) << "uv " << uvs[first + i].x << "," << uvs[first + i].y;
-      ASSERT_EQ(got.y.lane(i), want.g);
-      ASSERT_EQ(got.z.lane(i), want.b);
-      ASSERT_EQ(got.w.lane(i), want.a);
-    }
-    if (sampler.filter == Filter::kTrilinear) continue;
-    // The packed form (the texture shader's opaque output): the bytes the fragment stage makes of
-    // the scalar sample. Bilinear filtering rounds its 16-bit levels straight to bytes there.
-    simd::Int<N> packed = sample_rgba8<N>(texture, sampler, uv);
-    for (int i = 0; i < simd::kLanes; ++i) {
-      uint32_t want = pack_rgba8(texture.sample(sampler, uvs[first + i]));
-      ASSERT_EQ(uint32_t(packed.lane(i)), want)
-          << "uv " << uvs[first + i].x << "," << uvs[first + i].y;
+    // The pair, and the two bound as a SampledTexture (the built-in shaders' way): the same.
+    const SampledTexture bound(texture, sampler);
+    for (int way = 0; way < 2; ++way) {
+      simd::Vec4<N> got;
+      if (sampler.filter == Filter::kTrilinear) {
+        got = way == 0 ? sample<N>(texture, sampler, uv, dx, dy) : sample<N>(bound, uv, dx, dy);
+      } else {
+        got = way == 0 ? sample<N>(texture, sampler, uv) : sample<N>(bound, uv);
+      }
+      for (int i = 0; i < simd::kLanes; ++i) {
+        glm::vec4 want =
+            sampler.filter == Filter::kTrilinear
+                ? texture.sample(sampler, uvs[first + i], test_ddx(first + i), test_ddy(first + i))
+                : texture.sample(sampler, uvs[first + i]);
+        ASSERT_EQ(got.x.lane(i), want.r) << (way == 0 ? "pair" : "bound") << ", uv "
+                                         << uvs[first + i].x << "," << uvs[first + i].y;
+        ASSERT_EQ(got.y.lane(i), want.g);
+        ASSERT_EQ(got.z.lane(i), want.b);
+        ASSERT_EQ(got.w.lane(i), want.a);
+      }
+      if (sampler.filter == Filter::kTrilinear) continue;
+      // The packed form (the texture shader's opaque output): the bytes the fragment stage makes
+      // of the scalar sample. Bilinear filtering rounds its 16-bit levels straight to bytes there.
+      simd::Int<N> packed =
+          way == 0 ? sample_rgba8<N>(texture, sampler, uv) : sample_rgba8<N>(bound, uv);
+      for (int i = 0; i < simd::kLanes; ++i) {
+        uint32_t want = pack_rgba8(texture.sample(sampler, uvs[first + i]));
+        ASSERT_EQ(uint32_t(packed.lane(i)), want) << (way == 0 ? "pair" : "bound") << ", uv "
+                                                  << uvs[first + i].x << "," << uvs[first + i].y;
+      }
     }
   }
 }
@@ -419,11 +428,16 @@ TEST(SimdSampler, MatchesScalarSamplingBitForBitAtEveryLevel) {
       // An sRGB texture read through the decode table (its chain built in linear space).
       Texture texture = noise_texture(w, h, unsigned(w * 100 + h), srgb);
       for (Filter filter : {Filter::kNearest, Filter::kBilinear, Filter::kTrilinear}) {
-        for (Wrap wrap : {Wrap::kRepeat, Wrap::kClampToEdge, Wrap::kMirroredRepeat}) {
-          Sampler sampler{filter, wrap, wrap, srgb};
+        // Each mode on both axes, and repeat on one axis with clamping on the other.
+        for (auto [wrap_u, wrap_v] : {std::pair{Wrap::kRepeat, Wrap::kRepeat},
+                                      std::pair{Wrap::kClampToEdge, Wrap::kClampToEdge},
+                                      std::pair{Wrap::kMirroredRepeat, Wrap::kMirroredRepeat},
+                                      std::pair{Wrap::kRepeat, Wrap::kClampToEdge},
+                                      std::pair{Wrap::kClampToEdge, Wrap::kRepeat}}) {
+          Sampler sampler{filter, wrap_u, wrap_v, srgb};
           SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + " filter " +
-                       std::to_string(int(filter)) + " wrap " + std::to_string(int(wrap)) +
-                       (srgb ? " srgb" : ""));
+                       std::to_string(int(filter)) + " wrap " + std::to_string(int(wrap_u)) + "," +
+                       std::to_string(int(wrap_v)) + (srgb ? " srgb" : ""));
           check_sampler_at_native_width<4>(texture, sampler, uvs);
           // Both ways of gathering texels: the instruction and one load per lane.
           for (GatherMode mode : {GatherMode::kInstruction, GatherMode::kLoads}) {
@@ -686,7 +700,7 @@ struct FloatTextureTwin {
   glm::vec4 vertex(uint32_t i, float* v) const { return shader.vertex(i, v); }
   template <int N>
   void shade(Fragments<N>& f) const {
-    f.color = sample<N>(*shader.texture, shader.sampler, f.vec2(0));
+    f.color = sample<N>(shader.map.texture(), shader.map.sampler(), f.vec2(0));
   }
 };
 
@@ -698,10 +712,10 @@ TEST(SimdShader, BuiltInTextureShaderWritesBytesOnlyWhenOpaque) {
       {-0.9f, -0.8f, 0.1f}, {0.9f, -0.8f, -0.1f}, {0.9f, 0.8f, 0.2f}, {-0.9f, 0.8f, 0.0f}};
   quad.uvs = {{-0.4f, -0.7f}, {2.1f, -0.7f}, {2.1f, 1.6f}, {-0.4f, 1.6f}};
   std::vector<uint32_t> indices = {0, 1, 2, 0, 2, 3};
-  detail::TextureShader shader;
-  shader.in.mesh = &quad;
-  shader.texture = &texture;
-  shader.sampler = {Filter::kBilinear, Wrap::kRepeat, Wrap::kRepeat, false};
+  detail::MeshInputs inputs;
+  inputs.mesh = &quad;
+  detail::TextureShader shader(
+      inputs, SampledTexture(texture, {Filter::kBilinear, Wrap::kRepeat, Wrap::kRepeat, false}));
   for (BlendMode blend : {BlendMode::kOpaque, BlendMode::kAlpha}) {
     RenderState state;
     state.cull = CullMode::kNone;

@@ -238,6 +238,68 @@ class Texture {
   std::unique_ptr<MipState> mips_;  // null for an empty or moved-from texture
 };
 
+namespace detail {
+// What the AVX-512 sampler's common case needs of a texture and its sampler: the base level of an
+// RGBA8 texture without sRGB decode, filtered bilinearly, each axis clamped to the edge or
+// repeated over a power-of-two size. `texels` is null where the case does not apply.
+struct BilinearPlan {
+  const int32_t* texels = nullptr;
+  float width = 0.0f, height = 0.0f;  // the base level's size, as floats
+  int32_t last_u = 0, last_v = 0;     // the size minus one: the largest index, the repeat mask
+  bool repeat_u = false, repeat_v = false;  // else clamped to the edge
+  int32_t row_width = 0;                    // texels per row
+  int row_shift = -1;                       // log2(row_width) for a power of two, else -1
+
+  static BilinearPlan of(const Texture& t, const Sampler& s) {
+    BilinearPlan p;
+    const int w = t.width(), h = t.height();
+    const bool pow2_u = (w & (w - 1)) == 0, pow2_v = (h & (h - 1)) == 0;
+    const bool u_ok = s.wrap_u == Wrap::kClampToEdge || (s.wrap_u == Wrap::kRepeat && pow2_u);
+    const bool v_ok = s.wrap_v == Wrap::kClampToEdge || (s.wrap_v == Wrap::kRepeat && pow2_v);
+    if (s.filter != Filter::kBilinear || t.decodes(s) || !u_ok || !v_ok || t.empty()) return p;
+    p.texels = reinterpret_cast<const int32_t*>(t.texels());
+    p.width = float(w);
+    p.height = float(h);
+    p.last_u = w - 1;
+    p.last_v = h - 1;
+    p.repeat_u = s.wrap_u == Wrap::kRepeat;
+    p.repeat_v = s.wrap_v == Wrap::kRepeat;
+    p.row_width = w;
+    p.row_shift = pow2_u ? __builtin_ctz(unsigned(w)) : -1;
+    return p;
+  }
+};
+}  // namespace detail
+
+// A texture and the sampler it is read through, bound for a draw (a shader holds one per map):
+// what a wide sample would otherwise work out again for every block of 16 pixels (whether the
+// texture is empty, which filter and wrap modes apply, the base level's size) is worked out once
+// here. softrast::sample and sample_rgba8 take it in place of the pair, with the same results.
+// It points into the texture, which must outlive it unchanged: build one per draw.
+class SampledTexture {
+ public:
+  SampledTexture() : texture_(&no_texture()) {}  // samples as opaque white, as an empty texture
+  SampledTexture(const Texture& texture, const Sampler& sampler)
+      : texture_(&texture),
+        sampler_(sampler),
+        bilinear_(detail::BilinearPlan::of(texture, sampler)) {}
+  const Texture& texture() const { return *texture_; }
+  const Sampler& sampler() const { return sampler_; }
+  // The common case's plan, or null where another path samples.
+  const detail::BilinearPlan* bilinear() const {
+    return bilinear_.texels != nullptr ? &bilinear_ : nullptr;
+  }
+
+ private:
+  static const Texture& no_texture() {
+    static const Texture empty;
+    return empty;
+  }
+  const Texture* texture_;
+  Sampler sampler_;
+  detail::BilinearPlan bilinear_;
+};
+
 // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
 inline int Texture::wrap(Wrap mode, int i, int size) {
   switch (mode) {

@@ -59,11 +59,16 @@ struct MeshInputs {
 
 // Samples at the uv in varyings (i, i + 1), with their derivatives when the filter needs them.
 template <int N>
-SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_with_derivatives(const Texture& t, const Sampler& s,
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_with_derivatives(const SampledTexture& t,
                                                            const Fragments<N>& f, int i) {
   simd::Vec2<N> uv = f.vec2(i);
-  if (s.filter != Filter::kTrilinear) return sample<N>(t, s, uv);
-  return sample<N>(t, s, uv, {f.ddx(uv.x), f.ddx(uv.y)}, {f.ddy(uv.x), f.ddy(uv.y)});
+  if (t.sampler().filter != Filter::kTrilinear) return sample<N>(t, uv);
+  return sample<N>(t, uv, {f.ddx(uv.x), f.ddx(uv.y)}, {f.ddy(uv.x), f.ddy(uv.y)});
+}
+
+// A map bound to the sampler for a draw; no map samples as opaque white.
+inline SampledTexture bind_map(const Texture* map, const Sampler& s) {
+  return map != nullptr ? SampledTexture(*map, s) : SampledTexture();
 }
 
 // Where a shader takes a vertex's albedo from: the mesh's vertex colours (OBJ, PLY), when it has
@@ -137,14 +142,25 @@ struct GouraudShader {
   }
 };
 
+// Made for a draw and not changed after: what every block would test again is worked out when it
+// is made (the texture bound to its sampler, texel_as_is).
 struct TextureShader {
   static constexpr int kVaryings = 2;
   MeshInputs in;
-  const Texture* texture;
-  Sampler sampler;
+  SampledTexture map;  // the texture and its sampler
   float alpha = 1.0f;
   bool srgb = false;  // encode the output (the linear workflow)
-  bool reads_derivatives() const { return sampler.filter == Filter::kTrilinear; }
+  // Alpha 1, nothing encoded, no mip levels: an opaque draw writes the texel as it is, packed by
+  // the sampler (sample_rgba8: the same bytes).
+  bool texel_as_is = false;
+  TextureShader(const MeshInputs& inputs, const SampledTexture& texture, float alpha_ = 1.0f,
+                bool srgb_ = false)
+      : in(inputs),
+        map(texture),
+        alpha(alpha_),
+        srgb(srgb_),
+        texel_as_is(alpha_ == 1.0f && !srgb_ && texture.sampler().filter != Filter::kTrilinear) {}
+  bool reads_derivatives() const { return map.sampler().filter == Filter::kTrilinear; }
   glm::vec4 vertex(uint32_t i, float* v) const {
     glm::vec2 uv = in.uv(i);
     v[0] = uv.x, v[1] = uv.y;
@@ -152,13 +168,11 @@ struct TextureShader {
   }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
-    // Opaque, alpha 1, nothing encoded, no mip levels: the texel as it is, packed by the sampler
-    // (sample_rgba8: the same bytes).
-    if (f.opaque && alpha == 1.0f && !srgb && sampler.filter != Filter::kTrilinear) {
-      f.set_rgba8(sample_rgba8<N>(*texture, sampler, f.vec2(0)));
+    if (f.opaque && texel_as_is) {
+      f.set_rgba8(sample_rgba8<N>(map, f.vec2(0)));
       return;
     }
-    simd::Vec4<N> t = sample_with_derivatives(*texture, sampler, f, 0);
+    simd::Vec4<N> t = sample_with_derivatives(map, f, 0);
     f.color = {t.x, t.y, t.z, t.w * alpha};
     if (srgb) f.color = encode_srgb<N>(f.color);
   }
@@ -205,6 +219,24 @@ struct PhongShader {
   glm::vec3 eye;
   float alpha = 1.0f;
   ColorSource colors;  // kColors: the vertex colours (decoded as textures are)
+  // The maps bound to the sampler, worked out when the shader is made (for a draw, not changed
+  // after), so that no block tests the texture and sampler again.
+  SampledTexture diffuse_map, specular_map, normal_map, alpha_map;
+  PhongShader(const MeshInputs& inputs, const glm::vec3& albedo_, const SurfaceMaps& maps_,
+              const Sampler& sampler_, const Lighting& lighting_, const glm::vec3& eye_,
+              float alpha_, const ColorSource& colors_)
+      : in(inputs),
+        albedo(albedo_),
+        maps(maps_),
+        sampler(sampler_),
+        lighting(lighting_),
+        eye(eye_),
+        alpha(alpha_),
+        colors(colors_),
+        diffuse_map(bind_map(maps_.diffuse, sampler_)),
+        specular_map(bind_map(maps_.specular, sampler_)),
+        normal_map(bind_map(maps_.normal, sampler_)),
+        alpha_map(bind_map(maps_.alpha, sampler_)) {}
   // Only the maps' trilinear lookups read derivatives (shadows and lighting do not).
   bool reads_derivatives() const { return kUv && sampler.filter == Filter::kTrilinear; }
   glm::vec4 vertex(uint32_t i, float* v) const {
@@ -234,7 +266,7 @@ struct PhongShader {
     if constexpr (kUv) {
       if (maps.normal) {
         simd::Vec3<N> m =
-            map_normal<N>(sample_with_derivatives(*maps.normal, sampler, f, 6), maps.normal_scale);
+            map_normal<N>(sample_with_derivatives(normal_map, f, 6), maps.normal_scale);
         if (maps.object_space) {
           n = simd::normalize_fast(m);
         } else if constexpr (kTangents) {
@@ -259,13 +291,13 @@ struct PhongShader {
     simd::Vec3<N> ks = simd::splat3<N>(maps.specular_color);
     F a = F(alpha * maps.opacity);
     if constexpr (kUv) {
-      if (maps.diffuse) base = sample_with_derivatives(*maps.diffuse, sampler, f, 6);
+      if (maps.diffuse) base = sample_with_derivatives(diffuse_map, f, 6);
       if (maps.specular) {
-        simd::Vec4<N> k = sample_with_derivatives(*maps.specular, sampler, f, 6);
+        simd::Vec4<N> k = sample_with_derivatives(specular_map, f, 6);
         ks = ks * simd::Vec3<N>{k.x, k.y, k.z};
       }
       a = base.w * a;
-      if (maps.alpha) a = a * sample_with_derivatives(*maps.alpha, sampler, f, 6).x;
+      if (maps.alpha) a = a * sample_with_derivatives(alpha_map, f, 6).x;
     }
     // The shadow map is in world units: p without the position scale (exact: a power of two).
     F visible = lighting.shadow

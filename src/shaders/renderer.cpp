@@ -136,7 +136,8 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
                   indices, n);
     case ShaderKind::kTexture: {
       const Texture* t = surf.texture ? surf.texture : &kWhite;
-      return draw(fb, state, TextureShader{in, t, sampler, opt.alpha, opt.srgb}, indices, n);
+      return draw(fb, state, TextureShader{in, SampledTexture(*t, sampler), opt.alpha, opt.srgb},
+                  indices, n);
     }
     case ShaderKind::kPhong:
     case ShaderKind::kPbr: {  // pbr is drawn by render_pbr; phong if it ever gets here

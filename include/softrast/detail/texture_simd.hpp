@@ -204,16 +204,6 @@ namespace avx512 {
 
 #define SOFTRAST_AVX512_SAMPLER [[gnu::target("avx512f,avx512bw,avx512dq,avx512vl")]] inline
 
-// Whether bilinear_texels16 below takes `texture` sampled through `s`.
-inline bool bilinear_rgba8_applies(const Texture& texture, const Sampler& s) {
-  const int w = texture.width(), h = texture.height();
-  const bool u_ok =
-      s.wrap_u == Wrap::kClampToEdge || (s.wrap_u == Wrap::kRepeat && (w & (w - 1)) == 0);
-  const bool v_ok =
-      s.wrap_v == Wrap::kClampToEdge || (s.wrap_v == Wrap::kRepeat && (h & (h - 1)) == 0);
-  return s.filter == Filter::kBilinear && !texture.decodes(s) && u_ok && v_ok && !texture.empty();
-}
-
 // texel_floor: floor(x) and x - floor(x); NaN and |x| >= 1e9 give texel 0, fraction 0. (The
 // fraction of -0 comes out +0 here and -0 there; both give the weight 0.) Here and below, the
 // masked forms of the intrinsics and GCC's vector operators: the unmasked intrinsics of GCC 12's
@@ -231,10 +221,10 @@ SOFTRAST_AVX512_SAMPLER __m512i floor16(__m512 x, __m512& fraction) {
 
 // wrap_texel for the two modes bilinear_texels16 takes (`last`: the size minus one, a power of
 // two minus one when repeating).
-SOFTRAST_AVX512_SAMPLER __m512i wrap_clamp_or_repeat16(Wrap mode, __m512i i, int last) {
+SOFTRAST_AVX512_SAMPLER __m512i wrap_clamp_or_repeat16(bool repeat, __m512i i, int last) {
   using V = simd::Native<16>::I;
   V x = V(i);
-  if (mode == Wrap::kClampToEdge) {
+  if (!repeat) {
     x = x < 0 ? V{} : x;
     return __m512i(x > last ? V{} + last : x);
   }
@@ -259,38 +249,35 @@ SOFTRAST_AVX512_SAMPLER void gather_bilinear16(
   simd::isa::gather(texels, row1 + i1, t1);
 }
 
-// The four texels (bilinear_texels) and the weights' fractions of 16 lanes where
-// bilinear_rgba8_applies. Everything by reference: a caller compiled for the baseline (a test,
-// say) that does not inline this would pass 64-byte vectors in memory where it expects registers.
-SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const Texture& t, const Sampler& s,
-                                               const simd::Vec2<16>& uv, simd::Int<16>& b0,
-                                               simd::Int<16>& b1, simd::Int<16>& t0,
-                                               simd::Int<16>& t1, simd::Float<16>& fxl,
-                                               simd::Float<16>& fyl) {
+// The four texels (bilinear_texels) and the weights' fractions of 16 lanes in the common case
+// (BilinearPlan, texture.hpp). Everything by reference: a caller compiled for the baseline (a
+// test, say) that does not inline this would pass 64-byte vectors in memory where it expects
+// registers.
+SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const BilinearPlan& p, const simd::Vec2<16>& uv,
+                                               simd::Int<16>& b0, simd::Int<16>& b1,
+                                               simd::Int<16>& t0, simd::Int<16>& t1,
+                                               simd::Float<16>& fxl, simd::Float<16>& fyl) {
   using V = simd::Native<16>::I;
   const __m512 u = __m512(uv.x.p[0]), v = __m512(uv.y.p[0]);
-  const int w = t.width(), h = t.height();
   __m512 fx, fy;
   __m512i x0 =
-      floor16(_mm512_sub_ps(_mm512_mul_ps(u, _mm512_set1_ps(float(w))), _mm512_set1_ps(0.5f)), fx);
+      floor16(_mm512_sub_ps(_mm512_mul_ps(u, _mm512_set1_ps(p.width)), _mm512_set1_ps(0.5f)), fx);
   __m512i y0 =
-      floor16(_mm512_sub_ps(_mm512_mul_ps(v, _mm512_set1_ps(float(h))), _mm512_set1_ps(0.5f)), fy);
+      floor16(_mm512_sub_ps(_mm512_mul_ps(v, _mm512_set1_ps(p.height)), _mm512_set1_ps(0.5f)), fy);
   const __m512i one = _mm512_set1_epi32(1);
-  V i0 = V(wrap_clamp_or_repeat16(s.wrap_u, x0, w - 1));
-  V i1 = V(wrap_clamp_or_repeat16(s.wrap_u, _mm512_add_epi32(x0, one), w - 1));
-  V j0 = V(wrap_clamp_or_repeat16(s.wrap_v, y0, h - 1));
-  V j1 = V(wrap_clamp_or_repeat16(s.wrap_v, _mm512_add_epi32(y0, one), h - 1));
+  V i0 = V(wrap_clamp_or_repeat16(p.repeat_u, x0, p.last_u));
+  V i1 = V(wrap_clamp_or_repeat16(p.repeat_u, _mm512_add_epi32(x0, one), p.last_u));
+  V j0 = V(wrap_clamp_or_repeat16(p.repeat_v, y0, p.last_v));
+  V j1 = V(wrap_clamp_or_repeat16(p.repeat_v, _mm512_add_epi32(y0, one), p.last_v));
   V row0, row1;
-  if ((w & (w - 1)) == 0) {
-    const int shift = __builtin_ctz(unsigned(w));
-    row0 = j0 << shift;
-    row1 = j1 << shift;
+  if (p.row_shift >= 0) {
+    row0 = j0 << p.row_shift;
+    row1 = j1 << p.row_shift;
   } else {
-    row0 = j0 * w;
-    row1 = j1 * w;
+    row0 = j0 * p.row_width;
+    row1 = j1 * p.row_width;
   }
-  gather_bilinear16(reinterpret_cast<const int32_t*>(t.texels()), row0, row1, i0, i1, b0.p[0],
-                    b1.p[0], t0.p[0], t1.p[0]);
+  gather_bilinear16(p.texels, row0, row1, i0, i1, b0.p[0], b1.p[0], t0.p[0], t1.p[0]);
   fxl.p[0] = simd::Native<16>::F(fx);
   fyl.p[0] = simd::Native<16>::F(fy);
 }
@@ -514,27 +501,71 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_out_of_line(const Texture& texture, co
   return {F::load(io.out[0]), F::load(io.out[1]), F::load(io.out[2]), F::load(io.out[3])};
 }
 
+// sample() where `plan` is the common case's plan at 16 lanes (SampledTexture::bilinear), or
+// null: it is then sampled out of line.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_planned(const Texture& texture, const Sampler& s,
+                                                  const BilinearPlan* plan,
+                                                  const simd::Vec2<N>& uv) {
+  using F = simd::Float<N>;
+  if constexpr (N == 16) {
+    if (plan != nullptr) {
+      simd::Int<N> b0, b1, t0, t1;
+      F fx, fy;
+      avx512::bilinear_texels16(*plan, uv, b0, b1, t0, t1, fx, fy);
+      return filter_rgba8<N>(b0, b1, t0, t1, fx, fy);
+    }
+  }
+  if (texture.empty()) return {F(1.0f), F(1.0f), F(1.0f), F(1.0f)};
+  SampleLanes io;
+  uv.x.store(io.in[0]);
+  uv.y.store(io.in[1]);
+  return sample_out_of_line<N>(texture, s, io, false);
+}
+
+// sample_rgba8() with the plan given, as sample_planned.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8_planned(const Texture& texture, const Sampler& s,
+                                                       const BilinearPlan* plan,
+                                                       const simd::Vec2<N>& uv) {
+  if constexpr (N == 16) {
+    if (plan != nullptr) {
+      simd::Int<N> b0, b1, t0, t1;
+      simd::Float<N> fx, fy;
+      avx512::bilinear_texels16(*plan, uv, b0, b1, t0, t1, fx, fy);
+      return filter_rgba8_packed<N>(b0, b1, t0, t1, fx, fy);
+    }
+  }
+  if (texture.empty()) return simd::Int<N>(-1);  // opaque white
+  SampleLanes io;
+  uv.x.store(io.in[0]);
+  uv.y.store(io.in[1]);
+  if constexpr (N == 4) {
+    sample_rgba8_lanes_4(texture, s, io);
+  } else if constexpr (N == 8) {
+    sample_rgba8_lanes_8(texture, s, io);
+  } else {
+    static_assert(N == 16);
+    sample_rgba8_lanes_16(texture, s, io);
+  }
+  return simd::Int<N>::load(io.rgba8);
+}
+
 }  // namespace detail
 
-// Samples `texture` at 16 texture coordinates with the sampler's filter and wrap modes; an empty
-// texture samples as opaque white. The same results as Texture::sample, lane by lane.
+// Samples through `t` (a texture bound to its sampler) at 16 texture coordinates with the
+// sampler's filter and wrap modes; an empty texture samples as opaque white. The same results as
+// Texture::sample, lane by lane.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const SampledTexture& t, const simd::Vec2<N>& uv) {
+  return detail::sample_planned<N>(t.texture(), t.sampler(), t.bilinear(), uv);
+}
+
+// The same with the pair (bound for this one call: what SampledTexture works out once).
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler& s,
                                           const simd::Vec2<N>& uv) {
-  using F = simd::Float<N>;
-  if (texture.empty()) return {F(1.0f), F(1.0f), F(1.0f), F(1.0f)};
-  if constexpr (N == 16) {
-    if (detail::avx512::bilinear_rgba8_applies(texture, s)) {
-      simd::Int<N> b0, b1, t0, t1;
-      F fx, fy;
-      detail::avx512::bilinear_texels16(texture, s, uv, b0, b1, t0, t1, fx, fy);
-      return detail::filter_rgba8<N>(b0, b1, t0, t1, fx, fy);
-    }
-  }
-  detail::SampleLanes io;
-  uv.x.store(io.in[0]);
-  uv.y.store(io.in[1]);
-  return detail::sample_out_of_line<N>(texture, s, io, false);
+  return sample<N>(SampledTexture(texture, s), uv);
 }
 
 // sample() packed as RGBA8 (red in the low byte): exactly pack_rgba8(sample(...)), lane by lane,
@@ -542,29 +573,14 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler&
 // sRGB decode, the common case, rounds its 16-bit levels straight to bytes instead of going
 // through float and back.
 template <int N>
+SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8(const SampledTexture& t, const simd::Vec2<N>& uv) {
+  return detail::sample_rgba8_planned<N>(t.texture(), t.sampler(), t.bilinear(), uv);
+}
+
+template <int N>
 SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8(const Texture& texture, const Sampler& s,
                                                const simd::Vec2<N>& uv) {
-  if (texture.empty()) return simd::Int<N>(-1);  // opaque white
-  if constexpr (N == 16) {
-    if (detail::avx512::bilinear_rgba8_applies(texture, s)) {
-      simd::Int<N> b0, b1, t0, t1;
-      simd::Float<N> fx, fy;
-      detail::avx512::bilinear_texels16(texture, s, uv, b0, b1, t0, t1, fx, fy);
-      return detail::filter_rgba8_packed<N>(b0, b1, t0, t1, fx, fy);
-    }
-  }
-  detail::SampleLanes io;
-  uv.x.store(io.in[0]);
-  uv.y.store(io.in[1]);
-  if constexpr (N == 4) {
-    detail::sample_rgba8_lanes_4(texture, s, io);
-  } else if constexpr (N == 8) {
-    detail::sample_rgba8_lanes_8(texture, s, io);
-  } else {
-    static_assert(N == 16);
-    detail::sample_rgba8_lanes_16(texture, s, io);
-  }
-  return simd::Int<N>::load(io.rgba8);
+  return sample_rgba8<N>(SampledTexture(texture, s), uv);
 }
 
 // The same with the texture coordinates' change to the next pixel right and down (for example
@@ -583,6 +599,14 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler&
   duv_dy.x.store(io.in[4]);
   duv_dy.y.store(io.in[5]);
   return detail::sample_out_of_line<N>(texture, s, io, true);
+}
+
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const SampledTexture& t, const simd::Vec2<N>& uv,
+                                          const simd::Vec2<N>& duv_dx,
+                                          const simd::Vec2<N>& duv_dy) {
+  if (t.sampler().filter != Filter::kTrilinear) return sample<N>(t, uv);
+  return sample<N>(t.texture(), t.sampler(), uv, duv_dx, duv_dy);
 }
 
 }  // namespace softrast
