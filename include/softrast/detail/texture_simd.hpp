@@ -9,6 +9,7 @@
 #pragma GCC diagnostic ignored "-Wpsabi"
 
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 
 #include "softrast/simd.hpp"
@@ -231,16 +232,27 @@ SOFTRAST_AVX512_SAMPLER __m512i wrap_clamp_or_repeat16(bool repeat, __m512i i, i
   return __m512i(x & last);
 }
 
+// How far along its texel row the sampler's common case asks the cache for texels beyond each
+// of a block's four rows (simd::isa::gather_pair's `ahead`, on both rows of the filter: eight
+// lines). A triangle's blocks come left to right, so its next blocks read on along those rows,
+// and where the texture outgrows the L2 cache (quad_grid's 1024x1024, read over several repeats)
+// their lines would come from L3 while a block waits. 32 texels (two lines) measured faster than
+// 16 and 64; aiming at the next block's own texels (from the block's change across its row)
+// measured no faster than none.
+inline constexpr int kTexelsAhead = 32;
+
 // The four texels of each lane from its rows' first texels and its two columns: one 64-bit load
 // per lane and row where no lane wraps between its columns (sample_level), else four gathers.
-// (Also the out-of-line kernel's, sample_kernels.cpp.)
+// `ahead`: kTexelsAhead in the first case. (Also the out-of-line kernel's, sample_kernels.cpp,
+// without it.)
 SOFTRAST_AVX512_SAMPLER void gather_bilinear16(
     const int32_t* texels, const simd::Native<16>::I& row0, const simd::Native<16>::I& row1,
     const simd::Native<16>::I& i0, const simd::Native<16>::I& i1, simd::Native<16>::I& b0,
-    simd::Native<16>::I& b1, simd::Native<16>::I& t0, simd::Native<16>::I& t1) {
+    simd::Native<16>::I& b1, simd::Native<16>::I& t0, simd::Native<16>::I& t1, bool ahead = false) {
   if (_mm512_cmpneq_epi32_mask(__m512i(i1), __m512i(i0 + 1)) == 0) {
-    simd::isa::gather_pair(texels, row0 + i0, b0, b1);
-    simd::isa::gather_pair(texels, row1 + i0, t0, t1);
+    const int lead = ahead ? kTexelsAhead : 0;
+    simd::isa::gather_pair(texels, row0 + i0, b0, b1, simd::IndexRoute::kMemory, lead);
+    simd::isa::gather_pair(texels, row1 + i0, t0, t1, simd::IndexRoute::kMemory, lead);
     return;
   }
   simd::isa::gather(texels, row0 + i0, b0);
@@ -277,7 +289,7 @@ SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const BilinearPlan& p, const simd
     row0 = j0 * p.row_width;
     row1 = j1 * p.row_width;
   }
-  gather_bilinear16(p.texels, row0, row1, i0, i1, b0.p[0], b1.p[0], t0.p[0], t1.p[0]);
+  gather_bilinear16(p.texels, row0, row1, i0, i1, b0.p[0], b1.p[0], t0.p[0], t1.p[0], true);
   fxl.p[0] = simd::Native<16>::F(fx);
   fyl.p[0] = simd::Native<16>::F(fy);
 }
