@@ -714,8 +714,8 @@ TEST(SimdShader, BuiltInTextureShaderWritesBytesOnlyWhenOpaque) {
   std::vector<uint32_t> indices = {0, 1, 2, 0, 2, 3};
   detail::MeshInputs inputs;
   inputs.mesh = &quad;
-  detail::TextureShader shader(
-      inputs, SampledTexture(texture, {Filter::kBilinear, Wrap::kRepeat, Wrap::kRepeat, false}));
+  detail::TextureShader shader{
+      inputs, SampledTexture(texture, {Filter::kBilinear, Wrap::kRepeat, Wrap::kRepeat, false})};
   for (BlendMode blend : {BlendMode::kOpaque, BlendMode::kAlpha}) {
     RenderState state;
     state.cull = CullMode::kNone;

@@ -297,26 +297,15 @@ SOFTRAST_SIMD_INLINE Int<N> select(const Int<N>& mask, const Int<N>& a, const In
 // the other elements of `to` untouched. At AVX-512 one masked store; elsewhere a whole store for
 // all 16 lanes, else a blend into the values loaded and a whole store (AVX2's masked stores are
 // slow on AMD's Zen 3: core/store_mode.hpp).
-template <int N>
-SOFTRAST_SIMD_INLINE void store_lanes(const Int<N>& mask, uint32_t bits, const Float<N>& v,
-                                      float* to) {
+// (V: Float<N> with T = float, or Int<N> with T = int32_t.)
+template <int N, class V, class T>
+SOFTRAST_SIMD_INLINE void store_lanes(const Int<N>& mask, uint32_t bits, const V& v, T* to) {
   if constexpr (N == 16) {
     isa::store_lanes(bits, v.p[0], to);
   } else if (bits == 0xffffu) {
     v.store(to);
   } else {
-    select(mask, v, Float<N>::load(to)).store(to);
-  }
-}
-template <int N>
-SOFTRAST_SIMD_INLINE void store_lanes(const Int<N>& mask, uint32_t bits, const Int<N>& v,
-                                      int32_t* to) {
-  if constexpr (N == 16) {
-    isa::store_lanes(bits, v.p[0], to);
-  } else if (bits == 0xffffu) {
-    v.store(to);
-  } else {
-    select(mask, v, Int<N>::load(to)).store(to);
+    select(mask, v, V::load(to)).store(to);
   }
 }
 

@@ -142,24 +142,12 @@ struct GouraudShader {
   }
 };
 
-// Made for a draw and not changed after: what every block would test again is worked out when it
-// is made (the texture bound to its sampler, texel_as_is).
 struct TextureShader {
   static constexpr int kVaryings = 2;
   MeshInputs in;
   SampledTexture map;  // the texture and its sampler
   float alpha = 1.0f;
   bool srgb = false;  // encode the output (the linear workflow)
-  // Alpha 1, nothing encoded, no mip levels: an opaque draw writes the texel as it is, packed by
-  // the sampler (sample_rgba8: the same bytes).
-  bool texel_as_is = false;
-  TextureShader(const MeshInputs& inputs, const SampledTexture& texture, float alpha_ = 1.0f,
-                bool srgb_ = false)
-      : in(inputs),
-        map(texture),
-        alpha(alpha_),
-        srgb(srgb_),
-        texel_as_is(alpha_ == 1.0f && !srgb_ && texture.sampler().filter != Filter::kTrilinear) {}
   bool reads_derivatives() const { return map.sampler().filter == Filter::kTrilinear; }
   glm::vec4 vertex(uint32_t i, float* v) const {
     glm::vec2 uv = in.uv(i);
@@ -168,7 +156,9 @@ struct TextureShader {
   }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
-    if (f.opaque && texel_as_is) {
+    // Opaque, alpha 1, nothing encoded, no mip levels: the texel as it is, packed by the sampler
+    // (sample_rgba8: the same bytes).
+    if (f.opaque && alpha == 1.0f && !srgb && map.sampler().filter != Filter::kTrilinear) {
       f.set_rgba8(sample_rgba8<N>(map, f.vec2(0)));
       return;
     }
