@@ -59,4 +59,10 @@ int fuzz_geometry(const uint8_t* data, size_t size);
 // the pbr shader at 16x16; an error must be one line starting with the file name.
 int fuzz_gltf(const uint8_t* data, size_t size);
 
+// PLY (ASCII, binary little and big endian) and STL (binary and ASCII, both parsers on every
+// input) from memory (see model_formats.hpp): a mesh ready to draw with finite normals and
+// vertex colours in [0, 1], or an error of one line naming the file.
+int fuzz_ply(const uint8_t* data, size_t size);
+int fuzz_stl(const uint8_t* data, size_t size);
+
 }  // namespace softrast::fuzz

@@ -13,6 +13,7 @@
 #include <string_view>
 
 #include "fuzz_entries.hpp"
+#include "mesh_checks.hpp"
 #include "softrast/mesh.hpp"
 
 namespace softrast::fuzz {
@@ -46,28 +47,6 @@ std::string_view take_until(std::string_view& rest, std::string_view separator) 
   std::string_view part = rest.substr(0, at);
   rest = at == std::string_view::npos ? std::string_view() : rest.substr(at + separator.size());
   return part;
-}
-
-void check_mesh(const Mesh& mesh) {
-  SOFTRAST_FUZZ_REQUIRE(!mesh.indices.empty() && mesh.indices.size() % 3 == 0,
-                        "index count not 3n > 0");
-  SOFTRAST_FUZZ_REQUIRE(mesh.normals.size() == mesh.positions.size(),
-                        "normals and positions differ in count");
-  SOFTRAST_FUZZ_REQUIRE(mesh.uvs.size() == mesh.positions.size(),
-                        "uvs and positions differ in count");
-  for (uint32_t i : mesh.indices)
-    SOFTRAST_FUZZ_REQUIRE(i < mesh.positions.size(), "index out of range");
-  for (const glm::vec3& p : mesh.positions) {
-    SOFTRAST_FUZZ_REQUIRE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z),
-                          "non-finite position");
-  }
-  for (const SubMesh& s : mesh.submeshes) {
-    SOFTRAST_FUZZ_REQUIRE(size_t(s.first_index) + s.index_count <= mesh.indices.size(),
-                          "submesh past indices");
-    SOFTRAST_FUZZ_REQUIRE(s.index_count % 3 == 0, "submesh not whole triangles");
-    SOFTRAST_FUZZ_REQUIRE(s.material >= -1 && s.material < int(mesh.materials.size()),
-                          "bad material index");
-  }
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 # scripts/fuzz.sh TARGET MINUTES [--merge]: builds the libFuzzer targets if needed (cmake --preset
 # fuzz: clang, ASan, UBSan, in build/fuzz), runs one target for MINUTES at low priority, and
 # prints the executions, the coverage (libFuzzer's cov: edges and ft: features) and the crashes.
-#   TARGET: obj, png, tga, jpeg, cli_args, batch, geometry or gltf (fuzz/fuzz_entries.hpp says what each does)
+#   TARGET: obj, png, tga, jpeg, cli_args, batch, geometry, gltf, ply or stl (fuzz/fuzz_entries.hpp says what each does)
 #   The run starts from fuzz/corpus/TARGET (the committed seeds) and build/fuzz/corpus/TARGET
 #   (what earlier runs found; new inputs go there). Crashes, leaks, timeouts and out-of-memory
 #   inputs are written to build/fuzz/crashes/TARGET/; reproduce one with
@@ -13,7 +13,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-targets="obj png tga jpeg cli_args batch geometry gltf"
+targets="obj png tga jpeg cli_args batch geometry gltf ply stl"
 usage() {
   echo "usage: scripts/fuzz.sh TARGET MINUTES [--merge]   (TARGET: ${targets// /, })" >&2
   exit 2

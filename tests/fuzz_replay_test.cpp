@@ -28,7 +28,8 @@ struct Target {
 const Target kTargets[] = {{"obj", fuzz_obj},           {"png", fuzz_image},
                            {"tga", fuzz_image},         {"jpeg", fuzz_image},
                            {"cli_args", fuzz_cli_args}, {"batch", fuzz_batch},
-                           {"geometry", fuzz_geometry}, {"gltf", fuzz_gltf}};
+                           {"geometry", fuzz_geometry}, {"gltf", fuzz_gltf},
+                           {"ply", fuzz_ply},           {"stl", fuzz_stl}};
 
 std::vector<fs::path> files_in(const fs::path& dir) {
   std::vector<fs::path> files;
