@@ -459,6 +459,30 @@ TEST(CliFraming, ViewPresetsAreAngles) {
               folder.render(kBase + " --elevation 90", "b.png").rgba);
 }
 
+// An --eye straight above or below the --target, without --up: the model's up axis names no
+// direction in that image, so the model's front takes its place as in the top and bottom views
+// (the front at the image's bottom from above, at its top from below) instead of the camera's
+// "up is parallel" error, which an --up given along the view still gets.
+TEST(CliFraming, EyeStraightAboveOrBelowTakesTheFrontAsUp) {
+  CliFolder folder;
+  folder.write("part.obj", long_part_obj());
+  const std::string kBase = "part.obj --size 96x72 --shader flat --target 6,2.5,-6";
+  Image above = folder.render(kBase + " --eye 6,12,-6", "a.png");
+  ASSERT_FALSE(above.rgba.empty());
+  EXPECT_LE(model_extent(above).left, model_extent(above).right) << "no model pixel";
+  EXPECT_TRUE(above.rgba == folder.render(kBase + " --eye 6,12,-6 --up 0,0,-1", "b.png").rgba);
+  // The spike makes the part lopsided: the opposite up is another image.
+  EXPECT_FALSE(above.rgba == folder.render(kBase + " --eye 6,12,-6 --up 0,0,1", "c.png").rgba);
+  EXPECT_TRUE(folder.render(kBase + " --eye 6,-7,-6", "a.png").rgba ==
+              folder.render(kBase + " --eye 6,-7,-6 --up 0,0,1", "b.png").rgba);
+  // With --up-axis +z, looking along -z is looking down: the front is -y, so +y is up.
+  EXPECT_TRUE(folder.render(kBase + " --up-axis +z --eye 6,2.5,4", "a.png").rgba ==
+              folder.render(kBase + " --up-axis +z --eye 6,2.5,4 --up 0,1,0", "b.png").rgba);
+  CliResult given = folder.run(kBase + " --eye 6,12,-6 --up 0,1,0 -q -o d.png");
+  EXPECT_EQ(given.exit_code, 1);
+  EXPECT_NE(given.err.find("up is parallel to the view direction"), std::string::npos) << given.err;
+}
+
 // The same part made Z-up ((x, y, z) -> (x, -z, y)) and framed with --up-axis +z looks as the
 // Y-up part does by default: up is up and the front is the front.
 TEST(CliFraming, UpAxisZShowsAZUpModelUpright) {

@@ -33,7 +33,9 @@ void define_camera_flags(CLI::App& app, RawArgs& a) {
       ->type_name("X,Y,Z");
   app.add_option("--target", a.target, "Point looked at (default: the model's centre)")
       ->type_name("X,Y,Z");
-  app.add_option("--up", a.up, "Camera up direction (default: the model's up axis)")
+  app.add_option("--up", a.up,
+                 "Camera up direction (default: the model's up axis, or its front where --eye is "
+                 "straight above or below --target, as in the top and bottom views)")
       ->type_name("X,Y,Z");
   app.add_option("--up-axis", a.up_axis,
                  "The model's up direction: +x, -x, +y, -y, +z or -z (default +y; +z for models "

@@ -80,6 +80,20 @@ ViewFrame view_frame(const ModelFrame& m, Orientation o) {
   return {glm::cross(up, back), up, back};
 }
 
+// The image's up direction for a camera whose --up was not given: `preferred` (the view's), unless
+// the camera looks along it (an --eye straight above or below the --target), where it names no
+// direction in the image; then the model's front, as the top and bottom views take it: from
+// above the front is at the image's bottom, from below at its top. The parallel test is
+// Camera::validate's, which would refuse `preferred` there.
+glm::vec3 default_up(const Camera& camera, glm::vec3 preferred, const ModelFrame& m) {
+  glm::dvec3 back = glm::dvec3(camera.eye) - glm::dvec3(camera.target);
+  glm::dvec3 up(preferred);
+  if (glm::length(glm::cross(back, up)) > 1e-6 * glm::length(back) * glm::length(up)) {
+    return preferred;
+  }
+  return glm::dot(back, glm::dvec3(m.up)) > 0.0 ? -m.front : m.front;
+}
+
 bool flat_along(const Mesh& mesh, glm::vec3 axis) {
   glm::vec3 lo = mesh.positions.front(), hi = lo;
   for (const glm::vec3& p : mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
@@ -250,6 +264,7 @@ Camera frame_model(const Mesh& mesh, const CameraFlags& flags, float aspect) {
       camera.target = camera.eye - view.back * (distance > 0.0f ? distance : 1.0e-6f);
     }
   }
+  if (!flags.up) camera.up = default_up(camera, view.up, model_frame(flags.up_axis));
   auto [lo, hi] = vertex_depths(camera, mesh);
   set_depth_range(camera, lo, hi, flags);
   return camera;
@@ -277,6 +292,8 @@ Camera frame_model(const Bounds& bounds, const CameraFlags& flags, float aspect)
   glm::vec3 direction =
       bounds.flat_in_y ? glm::normalize(glm::vec3(0.0f, 1.0f, 1.0f)) : glm::vec3(0.0f, 0.0f, 1.0f);
   camera.eye = flags.eye.value_or(camera.target + direction * distance);
+  if (!flags.up)
+    camera.up = default_up(camera, camera.up, model_frame(glm::vec3(0.0f, 1.0f, 0.0f)));
   float to_center = float(glm::length(glm::dvec3(camera.eye) - glm::dvec3(bounds.center)));
   set_depth_range(camera, to_center - bounds.radius, to_center + bounds.radius, flags);
   return camera;
