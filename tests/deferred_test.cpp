@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/store_mode.hpp"
+#include "pipeline/tile_visibility.hpp"
 #include "softrast/shader.hpp"
 #include "softrast/simd_level.hpp"
 
@@ -288,6 +289,55 @@ TEST(Deferred, VisiblePixelsAreShadedOnceAndOnlyWhereAllowed) {
     greater.depth_write = true;
     EXPECT_EQ(count_shaded<ColorShader>(scene, greater), 0);  // nothing beats the clear depth 1
   }
+}
+
+// Two layers of large triangles (two quads filling the image, drawn back to front) overlap enough
+// to be deferred by worth_deferring: each visible pixel shaded once. Were the pixels each
+// triangle covers in a tile (Chunk::cover_area) estimated at half their number, each tile would
+// seem one layer deep and be shaded immediately, every fragment of both layers.
+TEST(Deferred, TwoLayersOfLargeTrianglesAreShadedOnce) {
+  Scene scene;
+  for (float z : {0.5f, -0.5f}) {
+    glm::vec4 a(-1, -1, z, 1), b(1, -1, z, 1), c(1, 1, z, 1), d(-1, 1, z, 1);
+    scene.triangle(a, b, c, glm::vec4(0.5f + z, 0.2f, 0.3f, 1.0f));
+    scene.triangle(a, c, d, glm::vec4(0.5f + z, 0.2f, 0.3f, 1.0f));
+  }
+  for (int threads : {1, 2}) {
+    RenderState state = opaque_state(DepthFunc::kLess);
+    state.threads = threads;
+    int visible = 0;
+    long shaded = count_shaded<ColorShader>(scene, state, &visible);
+    EXPECT_EQ(visible, 256 * 192);
+    EXPECT_EQ(shaded, visible) << "threads " << threads;
+  }
+}
+
+// The rule itself, on the loads that decide it (a 64x64 tile of 4096 pixels).
+TEST(Deferred, TileRuleDefersOverlapAndSmallTrianglesOnly) {
+  using detail::worth_deferring;
+  auto load = [](double boxes, double cover, int64_t records) {
+    detail::TileLoad t;
+    t.pixels = 4096;
+    t.boxes = int64_t(boxes * 4096);
+    t.cover = cover * 4096;
+    t.records = records;
+    return t;
+  };
+  // One layer of a mesh: boxes about twice the area.
+  EXPECT_FALSE(worth_deferring(load(2.2, 1.0, 300)));
+  // One layer of slivers (boxes past three tiles): small triangles, deferred.
+  EXPECT_TRUE(worth_deferring(load(3.5, 1.0, 200)));
+  // A few long triangles crossing the tile, each pixel once (quad_grid): immediate.
+  EXPECT_FALSE(worth_deferring(load(4.0, 1.0, 6)));
+  EXPECT_FALSE(worth_deferring(load(4.0, 1.5, 6)));
+  // The same overlapping a little more, or in two layers: deferred.
+  EXPECT_TRUE(worth_deferring(load(4.0, 1.6, 6)));
+  EXPECT_TRUE(worth_deferring(load(4.0, 2.0, 4)));
+  // Heavy overdraw of large quads: deferred.
+  EXPECT_TRUE(worth_deferring(load(128.0, 64.0, 128)));
+  // The triangle size where small starts: 128 pixels of the tile each.
+  EXPECT_FALSE(worth_deferring(load(4.0, 1.0, 32)));
+  EXPECT_TRUE(worth_deferring(load(4.0, 1.0, 33)));
 }
 
 // ---- Wide shaders: derivatives, depth and facing through both paths. ----

@@ -22,6 +22,35 @@
 
 namespace softrast::detail {
 
+// What a tile's records of one draw amount to, for worth_deferring: its pixels (inside the
+// image), the area of the records' bounding boxes clipped to it, the pixels they cover in it
+// (estimated: each box's share times the triangle's share of its whole box, at most a half) and
+// how many there are.
+struct TileLoad {
+  int64_t pixels = 0;
+  int64_t boxes = 0;
+  double cover = 0.0;
+  int64_t records = 0;
+};
+
+// Deferred shading pays for its visibility pass where triangles overlap, and where they are small
+// (the visible pixels of many triangles shaded in full groups instead of each triangle's partly
+// covered blocks). A tile whose boxes add up to at most kDeferredDepth times its area (one layer
+// of a mesh: each triangle's box is about twice its area) is shaded immediately; so is a tile of
+// large triangles (kDeferredPixels of the tile each or more, on average) that overlap little
+// (covering at most kDeferredCover times its area), such as quad_grid's tiles where a few long
+// triangles cross: their boxes add up to more than three tiles, yet they cover each pixel once.
+// Either way gives the same image (the deferred tests compare the two bit for bit); this only
+// picks the faster.
+inline constexpr int64_t kDeferredDepth = 3;
+inline constexpr double kDeferredCover = 1.5;
+inline constexpr double kDeferredPixels = 128.0;
+inline bool worth_deferring(const TileLoad& t) {
+  if (t.boxes <= kDeferredDepth * t.pixels) return false;
+  return t.cover > kDeferredCover * double(t.pixels) ||
+         t.cover < kDeferredPixels * double(t.records);
+}
+
 // A tile's depth and winners, 4x4-block-major: block (bx, by) of the tile holds its 16 pixels in
 // one 64-byte line each for depth and id (lane 4 * row + column, like the coverage masks), so the
 // resolve kernels load and store whole blocks as one vector. A block's depth is copied in from the
