@@ -338,6 +338,22 @@ TEST(Deferred, TileRuleDefersOverlapAndSmallTrianglesOnly) {
   // The triangle size where small starts: 128 pixels of the tile each.
   EXPECT_FALSE(worth_deferring(load(4.0, 1.0, 32)));
   EXPECT_TRUE(worth_deferring(load(4.0, 1.0, 33)));
+  // The cover is estimated only where it can change the answer (cover_matters): with few
+  // records past three tiles of boxes.
+  EXPECT_TRUE(detail::cover_matters(load(4.0, 0.0, 6)));
+  EXPECT_TRUE(detail::cover_matters(load(4.0, 0.0, 48)));
+  EXPECT_FALSE(detail::cover_matters(load(4.0, 0.0, 49)));
+  EXPECT_FALSE(detail::cover_matters(load(2.0, 0.0, 6)));
+  for (double boxes : {2.0, 3.5, 8.0}) {
+    for (int64_t records : {1, 6, 32, 48, 49, 200}) {
+      if (detail::cover_matters(load(boxes, 0.0, records))) continue;
+      const bool answer = worth_deferring(load(boxes, 0.0, records));
+      for (double cover : {0.25, 1.0, 1.5, 1.6, 3.0, 64.0}) {
+        EXPECT_EQ(worth_deferring(load(boxes, cover, records)), answer)
+            << boxes << " " << cover << " " << records;
+      }
+    }
+  }
 }
 
 // ---- Wide shaders: derivatives, depth and facing through both paths. ----

@@ -69,14 +69,8 @@ constexpr size_t kPrefetchStep = 4;
 struct alignas(64) Chunk {
   RecordArena records;
   std::vector<std::vector<uint32_t>> bins;  // per tile: offsets of its records in `records`
-  // Per tile (deferrable draws), side by side so that binning a triangle adds to both in one
-  // cache line: the area of its records' bounding boxes clipped to it, in pixels, and the pixels
-  // they cover in it, estimated (cover_estimate), in units of signed_area_fx16 (2^-17 pixel).
-  struct TileSums {
-    int64_t box = 0;
-    int64_t cover = 0;
-  };
-  std::vector<TileSums> sums;
+  // Per tile (deferrable draws): the area of its records' bounding boxes clipped to it.
+  std::vector<int64_t> box_area;
 };
 
 // A tile worker's scratch for the draws that may defer (deferred tiles, and the batch of the
@@ -162,7 +156,7 @@ class BinnedDraw {
     if (cache_.chunks.size() < sets * num_chunks_) cache_.chunks.resize(sets * num_chunks_);
     for (size_t c = 0; c < sets * num_chunks_; ++c) {
       cache_.chunks[c].bins.resize(size_t(tiles_x_) * size_t(tiles_y_));
-      cache_.chunks[c].sums.resize(deferred_ ? size_t(tiles_x_) * size_t(tiles_y_) : 0);
+      cache_.chunks[c].box_area.resize(deferred_ ? size_t(tiles_x_) * size_t(tiles_y_) : 0);
     }
     auto setup_of = [&](size_t b) {
       SetupJobs jobs;
@@ -199,7 +193,7 @@ class BinnedDraw {
   void setup_chunk(Chunk& chunk, const uint32_t* indices, size_t begin, size_t end) {
     chunk.records.clear();
     for (std::vector<uint32_t>& bin : chunk.bins) bin.clear();
-    std::fill(chunk.sums.begin(), chunk.sums.end(), Chunk::TileSums{});
+    std::fill(chunk.box_area.begin(), chunk.box_area.end(), 0);
     auto add = [&](const WindowVertex& a, const WindowVertex& b, const WindowVertex& c) {
       add_triangle(chunk, a, b, c);
     };
@@ -278,7 +272,7 @@ class BinnedDraw {
     GroupTiles tiles;
     write_records(lanes, width, geometry_.num_varyings(), state_.front_face, dest, tiles_x_, tiles);
     uint32_t offset = first;
-    const bool box_area = !chunk.sums.empty();
+    const bool box_area = !chunk.box_area.empty();
     for (uint32_t todo = lanes.ready; todo != 0; todo &= todo - 1) {
       const int l = __builtin_ctz(todo);
       auto bounds = [&] {
@@ -286,9 +280,9 @@ class BinnedDraw {
                          lanes.bounds[3][l]};
       };
       if ((tiles.spans >> l) & 1u) {
-        bin(chunk, bounds(), offset, lanes.area[l]);
+        bin(chunk, bounds(), offset);
       } else if (box_area) {
-        bin_in_tile(chunk, tiles.tile[l], bounds(), offset, lanes.area[l]);
+        bin_in_tile(chunk, tiles.tile[l], bounds(), offset);
       } else {
         chunk.bins[tiles.tile[l]].push_back(offset);
       }
@@ -313,7 +307,7 @@ class BinnedDraw {
       return;
     }
     write_planes(lanes, l, geometry_.num_varyings(), state_.front_face, rec->interp());
-    bin(chunk, rec->bounds, offset, lanes.area[l]);
+    bin(chunk, rec->bounds, offset);
   }
 
   // Both paths end here: the record's interpolants (from the clockwise-ordered vertices) and its
@@ -323,7 +317,7 @@ class BinnedDraw {
     TriRecord* rec = chunk.records.at(offset);
     setup_triangle_interpolants(ordered, geometry_.num_varyings(), area, state_.front_face,
                                 rec->interp());
-    bin(chunk, rec->bounds, offset, area);
+    bin(chunk, rec->bounds, offset);
   }
 
   // Whether a triangle of snapped signed area `area` survives culling (zero area never does).
@@ -358,58 +352,40 @@ class BinnedDraw {
     finish_record(chunk, offset, ordered, area);
   }
 
-  // The pixels a triangle of snapped signed area `area` (signed_area_fx16) with bounds `bounds`
-  // covers in `clipped` pixels of them, in units of `area`: as many as its share of the bounds
-  // (at most a half) says, which for a triangle inside them all is its area.
-  static int64_t cover_estimate(int64_t clipped, const PixelRect& bounds, int64_t area) {
-    double box = double(bounds.x1 - bounds.x0) * double(bounds.y1 - bounds.y0);
-    double share = std::min(1.0, std::abs(double(area)) / (box * kAreaPerPixel));
-    return int64_t(double(clipped) * share * kAreaPerPixel);
-  }
-  static constexpr double kAreaPerPixel = 2.0 * kSubpixelOne * kSubpixelOne;
-
   // Inline, for the usual triangle of a dense mesh: one tile, all of it; the rest out of line
-  // (with it inline too, the function kept six registers saved and restored per record). `area`:
-  // the triangle's signed_area_fx16.
-  void bin(Chunk& chunk, const PixelRect& bounds, uint32_t offset, int64_t area) {
+  // (with it inline too, the function kept six registers saved and restored per record).
+  void bin(Chunk& chunk, const PixelRect& bounds, uint32_t offset) {
     // The bounds lie inside the scissor: no coordinate is negative.
     int tx0 = int(unsigned(bounds.x0) / kTileSize), tx1 = int(unsigned(bounds.x1 - 1) / kTileSize);
     int ty0 = int(unsigned(bounds.y0) / kTileSize), ty1 = int(unsigned(bounds.y1 - 1) / kTileSize);
     if (tx0 != tx1 || ty0 != ty1) {
-      bin_tiles(chunk, bounds, offset, tx0, ty0, tx1, ty1, area);
+      bin_tiles(chunk, bounds, offset, tx0, ty0, tx1, ty1);
       return;
     }
-    bin_in_tile(chunk, size_t(ty0) * tiles_x_ + tx0, bounds, offset, area);
+    bin_in_tile(chunk, size_t(ty0) * tiles_x_ + tx0, bounds, offset);
   }
 
   // bin() for a triangle whose bounds lie in one tile.
-  void bin_in_tile(Chunk& chunk, size_t tile, const PixelRect& bounds, uint32_t offset,
-                   int64_t area) {
+  void bin_in_tile(Chunk& chunk, size_t tile, const PixelRect& bounds, uint32_t offset) {
     chunk.bins[tile].push_back(offset);
-    if (!chunk.sums.empty()) {
-      int64_t box = int64_t(bounds.x1 - bounds.x0) * (bounds.y1 - bounds.y0);
-      Chunk::TileSums& sums = chunk.sums[tile];
-      sums.box += box;
-      // cover_estimate of the whole box without its division: the area, at most the box.
-      sums.cover += std::min(box * int64_t(kAreaPerPixel), area < 0 ? -area : area);
+    if (!chunk.box_area.empty()) {
+      chunk.box_area[tile] += int64_t(bounds.x1 - bounds.x0) * (bounds.y1 - bounds.y0);
     }
   }
 
   // bin() for a triangle whose bounds span tiles [tx0, tx1] x [ty0, ty1].
   [[gnu::noinline]] void bin_tiles(Chunk& chunk, const PixelRect& bounds, uint32_t offset, int tx0,
-                                   int ty0, int tx1, int ty1, int64_t area) {
+                                   int ty0, int tx1, int ty1) {
     for (int ty = ty0; ty <= ty1; ++ty) {
       for (int tx = tx0; tx <= tx1; ++tx) chunk.bins[size_t(ty) * tiles_x_ + tx].push_back(offset);
     }
-    if (chunk.sums.empty()) return;
+    if (chunk.box_area.empty()) return;
     // The bounds lie inside the scissor, so clipped to the tile they are clipped to its region.
     for (int ty = ty0; ty <= ty1; ++ty) {
       int64_t h = std::min(bounds.y1, (ty + 1) * kTileSize) - std::max(bounds.y0, ty * kTileSize);
       for (int tx = tx0; tx <= tx1; ++tx) {
         int64_t w = std::min(bounds.x1, (tx + 1) * kTileSize) - std::max(bounds.x0, tx * kTileSize);
-        Chunk::TileSums& sums = chunk.sums[size_t(ty) * tiles_x_ + tx];
-        sums.box += w * h;
-        sums.cover += cover_estimate(w * h, bounds, area);
+        chunk.box_area[size_t(ty) * tiles_x_ + tx] += w * h;
       }
     }
   }
@@ -509,21 +485,33 @@ class BinnedDraw {
     return p;
   }
 
-  // Whether the tile's records are shaded deferred (worth_deferring, tile_visibility.hpp), from
-  // the sums made while binning (Chunk::sums): reading every record's bounds again
-  // here cost a cache miss per record and tile.
+  // Whether the tile's records are shaded deferred (worth_deferring, tile_visibility.hpp). The box
+  // areas are summed while binning (Chunk::box_area): reading every record's bounds again here
+  // cost a cache miss per record and tile. The pixels the records cover are estimated only where
+  // the rule needs them (cover_matters: few records), from the records: each clipped box times
+  // the triangle's share of its whole box (at most a half), which for a triangle inside the tile
+  // is its area.
   bool worth_deferring(size_t tile) const {
     PixelRect region = tile_region(tile);
     TileLoad load;
     load.pixels = int64_t(region.x1 - region.x0) * (region.y1 - region.y0);
-    for (const Chunk& chunk : chunks()) {
-      load.boxes += chunk.sums[tile].box;
-      load.cover += double(chunk.sums[tile].cover) / kAreaPerPixel;
-    }
-    // The count only where the rule reads it (a bin's size is another line per chunk and tile:
-    // spheres_1m, two threads, was 1 % slower counting every tile's).
-    if (load.boxes > kDeferredDepth * load.pixels) {
-      for (const Chunk& chunk : chunks()) load.records += int64_t(chunk.bins[tile].size());
+    for (const Chunk& chunk : chunks()) load.boxes += chunk.box_area[tile];
+    if (load.boxes <= kDeferredDepth * load.pixels) return false;
+    for (const Chunk& chunk : chunks()) load.records += int64_t(chunk.bins[tile].size());
+    if (cover_matters(load)) {
+      for (const Chunk& chunk : chunks()) {
+        for (uint32_t offset : chunk.bins[tile]) {
+          const TriRecord& rec = record(chunk, offset);
+          const PixelRect& b = rec.bounds;
+          const PixelRect in = intersect(b, region);
+          // Twice the area in 1/256 pixels squared: the cross product of two edges' normals.
+          double area = std::abs(double(rec.edge[0].a) * double(rec.edge[1].b) -
+                                 double(rec.edge[1].a) * double(rec.edge[0].b)) /
+                        (2.0 * kSubpixelOne * kSubpixelOne);
+          double box = double(b.x1 - b.x0) * double(b.y1 - b.y0);
+          load.cover += double(in.x1 - in.x0) * double(in.y1 - in.y0) * std::min(1.0, area / box);
+        }
+      }
     }
     return detail::worth_deferring(load);
   }

@@ -45,6 +45,13 @@ struct TileLoad {
 inline constexpr int64_t kDeferredDepth = 3;
 inline constexpr double kDeferredCover = 1.5;
 inline constexpr double kDeferredPixels = 128.0;
+// Whether worth_deferring reads t.cover (boxes past kDeferredDepth tiles, and few enough records
+// that their average share of the tile could reach kDeferredPixels): elsewhere its answer is the
+// same whatever the cover, which need not be estimated.
+inline bool cover_matters(const TileLoad& t) {
+  return t.boxes > kDeferredDepth * t.pixels &&
+         kDeferredPixels * double(t.records) <= kDeferredCover * double(t.pixels);
+}
 inline bool worth_deferring(const TileLoad& t) {
   if (t.boxes <= kDeferredDepth * t.pixels) return false;
   return t.cover > kDeferredCover * double(t.pixels) ||
