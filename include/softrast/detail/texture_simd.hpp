@@ -513,56 +513,6 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_out_of_line(const Texture& texture, co
   return {F::load(io.out[0]), F::load(io.out[1]), F::load(io.out[2]), F::load(io.out[3])};
 }
 
-// sample() where `plan` is the common case's plan at 16 lanes (SampledTexture::bilinear), or
-// null: it is then sampled out of line.
-template <int N>
-SOFTRAST_SIMD_INLINE simd::Vec4<N> sample_planned(const Texture& texture, const Sampler& s,
-                                                  const BilinearPlan* plan,
-                                                  const simd::Vec2<N>& uv) {
-  using F = simd::Float<N>;
-  if constexpr (N == 16) {
-    if (plan != nullptr) {
-      simd::Int<N> b0, b1, t0, t1;
-      F fx, fy;
-      avx512::bilinear_texels16(*plan, uv, b0, b1, t0, t1, fx, fy);
-      return filter_rgba8<N>(b0, b1, t0, t1, fx, fy);
-    }
-  }
-  if (texture.empty()) return {F(1.0f), F(1.0f), F(1.0f), F(1.0f)};
-  SampleLanes io;
-  uv.x.store(io.in[0]);
-  uv.y.store(io.in[1]);
-  return sample_out_of_line<N>(texture, s, io, false);
-}
-
-// sample_rgba8() with the plan given, as sample_planned.
-template <int N>
-SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8_planned(const Texture& texture, const Sampler& s,
-                                                       const BilinearPlan* plan,
-                                                       const simd::Vec2<N>& uv) {
-  if constexpr (N == 16) {
-    if (plan != nullptr) {
-      simd::Int<N> b0, b1, t0, t1;
-      simd::Float<N> fx, fy;
-      avx512::bilinear_texels16(*plan, uv, b0, b1, t0, t1, fx, fy);
-      return filter_rgba8_packed<N>(b0, b1, t0, t1, fx, fy);
-    }
-  }
-  if (texture.empty()) return simd::Int<N>(-1);  // opaque white
-  SampleLanes io;
-  uv.x.store(io.in[0]);
-  uv.y.store(io.in[1]);
-  if constexpr (N == 4) {
-    sample_rgba8_lanes_4(texture, s, io);
-  } else if constexpr (N == 8) {
-    sample_rgba8_lanes_8(texture, s, io);
-  } else {
-    static_assert(N == 16);
-    sample_rgba8_lanes_16(texture, s, io);
-  }
-  return simd::Int<N>::load(io.rgba8);
-}
-
 }  // namespace detail
 
 // Samples through `t` (a texture bound to its sampler) at 16 texture coordinates with the
@@ -570,7 +520,20 @@ SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8_planned(const Texture& texture, c
 // Texture::sample, lane by lane.
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const SampledTexture& t, const simd::Vec2<N>& uv) {
-  return detail::sample_planned<N>(t.texture(), t.sampler(), t.bilinear(), uv);
+  using F = simd::Float<N>;
+  if constexpr (N == 16) {
+    if (const detail::BilinearPlan* plan = t.bilinear()) {  // the common case, inline
+      simd::Int<N> b0, b1, t0, t1;
+      F fx, fy;
+      detail::avx512::bilinear_texels16(*plan, uv, b0, b1, t0, t1, fx, fy);
+      return detail::filter_rgba8<N>(b0, b1, t0, t1, fx, fy);
+    }
+  }
+  if (t.texture().empty()) return {F(1.0f), F(1.0f), F(1.0f), F(1.0f)};
+  detail::SampleLanes io;
+  uv.x.store(io.in[0]);
+  uv.y.store(io.in[1]);
+  return detail::sample_out_of_line<N>(t.texture(), t.sampler(), io, false);
 }
 
 // The same with the pair (bound for this one call: what SampledTexture works out once).
@@ -586,7 +549,27 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler&
 // through float and back.
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8(const SampledTexture& t, const simd::Vec2<N>& uv) {
-  return detail::sample_rgba8_planned<N>(t.texture(), t.sampler(), t.bilinear(), uv);
+  if constexpr (N == 16) {
+    if (const detail::BilinearPlan* plan = t.bilinear()) {  // the common case, inline
+      simd::Int<N> b0, b1, t0, t1;
+      simd::Float<N> fx, fy;
+      detail::avx512::bilinear_texels16(*plan, uv, b0, b1, t0, t1, fx, fy);
+      return detail::filter_rgba8_packed<N>(b0, b1, t0, t1, fx, fy);
+    }
+  }
+  if (t.texture().empty()) return simd::Int<N>(-1);  // opaque white
+  detail::SampleLanes io;
+  uv.x.store(io.in[0]);
+  uv.y.store(io.in[1]);
+  if constexpr (N == 4) {
+    detail::sample_rgba8_lanes_4(t.texture(), t.sampler(), io);
+  } else if constexpr (N == 8) {
+    detail::sample_rgba8_lanes_8(t.texture(), t.sampler(), io);
+  } else {
+    static_assert(N == 16);
+    detail::sample_rgba8_lanes_16(t.texture(), t.sampler(), io);
+  }
+  return simd::Int<N>::load(io.rgba8);
 }
 
 template <int N>
