@@ -393,6 +393,83 @@ struct EdgeGrid {
   }
 };
 
+// The blocks of a small triangle's area (the 32-bit bound of fixed_point.hpp holds) a row of
+// blocks at a time: the row's blocks, at most 16 inside a tile, are the lanes of kGroups vectors,
+// and one pass of additions and sign masks tells which lie outside an edge and which inside all
+// three (classify's test, exactly, at every block of the row), so that only blocks the triangle
+// reaches are visited. (Block by block, the hierarchical walk below spent about 9 % of diablo3's
+// frame classifying blocks, most of them outside a medium triangle's edges, on branches that its
+// varying shapes make unpredictable.)
+//
+// Every value is a sample value of a block that overlaps the area, so it fits in int32 (the
+// lanes past the area's last column are computed in unsigned arithmetic, wrapping harmlessly,
+// and masked off).
+typedef uint32_t U __attribute__((vector_size(4 * kLanes)));
+
+struct BlockRows {
+  U column[3][kGroups];   // E's change from the row's first block to the lane's block
+  uint32_t lo[3], hi[3];  // added to E at a block's first sample: its minimum and maximum
+  uint32_t step[3];       // E's change from one block to the next right
+  uint32_t row_step[3];   // E's change from one row of blocks to the next
+};
+
+[[gnu::always_inline]] inline void block_rows(const TriRecord& t, BlockRows& r) {
+  const EdgeExtents x = edge_extents(t, kBlockSize);
+  for (int k = 0; k < 3; ++k) {
+    const uint32_t step = uint32_t(t.edge[k].a * (kSubpixelOne * kBlockSize));
+    r.step[k] = step;
+    for (int g = 0; g < kGroups; ++g) r.column[k][g] = U(pixel_index(g)) * step;
+    r.lo[k] = uint32_t(x.lo[k]);
+    r.hi[k] = uint32_t(x.hi[k]);
+    r.row_step[k] = uint32_t(t.edge[k].b * (kSubpixelOne * kBlockSize));
+  }
+}
+
+// Bits of the row's blocks (bit i: the block i columns right of the first) that lie outside an
+// edge (`outside`) and that some edge cuts (`cut`); `e`: E at the first block's first sample.
+[[gnu::always_inline]] inline void classify_row(const BlockRows& r, const uint32_t e[3],
+                                                uint32_t& outside, uint32_t& cut) {
+  outside = 0;
+  cut = 0;
+  for (int g = 0; g < kGroups; ++g) {
+    const U v0 = (U{} + e[0]) + r.column[0][g], v1 = (U{} + e[1]) + r.column[1][g],
+            v2 = (U{} + e[2]) + r.column[2][g];
+    outside |= lane_bits(I((v0 + r.hi[0]) | (v1 + r.hi[1]) | (v2 + r.hi[2]))) << (g * kLanes);
+    cut |= lane_bits(I((v0 + r.lo[0]) | (v1 + r.lo[1]) | (v2 + r.lo[2]))) << (g * kLanes);
+  }
+}
+
+template <class Emit, class Region, class Partial>
+[[gnu::always_inline]] inline void raster_block_rows(const TriRecord& t, const PixelRect& area,
+                                                     const EdgeGrid& grid, Emit& emit,
+                                                     Region& region, Partial& partial_block) {
+  BlockRows rows;
+  block_rows(t, rows);
+  const int bx0 = area.x0 & ~(kBlockSize - 1), by0 = area.y0 & ~(kBlockSize - 1);
+  const int columns = (area.x1 - bx0 + kBlockSize - 1) / kBlockSize;  // at most 16 in a tile
+  const uint32_t in_area = (1u << columns) - 1u;
+  int64_t row[3];
+  grid.at(bx0, by0, row);
+  uint32_t e_row[3] = {uint32_t(row[0]), uint32_t(row[1]), uint32_t(row[2])};
+  for (int y = by0; y < area.y1; y += kBlockSize) {
+    uint32_t outside, cut;
+    classify_row(rows, e_row, outside, cut);
+    const uint32_t reached = ~outside & in_area;
+    for (uint32_t left = reached; left != 0; left &= left - 1) {
+      const int i = __builtin_ctz(left);
+      const int x = bx0 + kBlockSize * i;
+      if (((cut >> i) & 1u) == 0) {
+        emit(x, y, region(x, y));
+      } else {
+        int64_t e[3];
+        for (int k = 0; k < 3; ++k) e[k] = int32_t(e_row[k] + uint32_t(i) * rows.step[k]);
+        partial_block(x, y, e);
+      }
+    }
+    for (int k = 0; k < 3; ++k) e_row[k] += rows.row_step[k];
+  }
+}
+
 template <Mode kMode, class V, class T>
 [[gnu::always_inline]] inline void raster_record_with(TileJob& job, const TriRecord& rec,
                                                       int32_t id, const PixelRect& area,
@@ -430,8 +507,13 @@ template <Mode kMode, class V, class T>
     }
     return;
   }
-  // Larger: 16x16 blocks, then 4x4 blocks, trivially rejected or accepted (a block inside every
-  // edge is emitted without per-pixel tests); only the rest is tested pixel by pixel.
+  if constexpr (sizeof(T) == 4) {
+    raster_block_rows(t, area, grid, emit, region, partial_block);
+    return;
+  }
+  // Larger, past the 32-bit bound: 16x16 blocks, then 4x4 blocks, trivially rejected or accepted
+  // (a block inside every edge is emitted without per-pixel tests); only the rest is tested pixel
+  // by pixel.
   const EdgeExtents mid = edge_extents(t, kMidBlockSize), small = edge_extents(t, kBlockSize);
   E4 next_block, e;
   grid.block_step_x(next_block);
