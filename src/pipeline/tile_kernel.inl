@@ -470,6 +470,47 @@ template <class Emit, class Region, class Partial>
   }
 }
 
+// The same for an area of at most 4x4 blocks (16x16 pixels): all its blocks classified at once,
+// lane p of the kGroups vectors the block p & 3 columns right and p >> 2 rows down of the first
+// (pixel_index's layout, in blocks: the pixel offsets `o` times 4).
+template <class Emit, class Region, class Partial>
+[[gnu::always_inline]] inline void raster_block_square(const TriRecord& t, const PixelRect& area,
+                                                       const EdgeGrid& grid,
+                                                       const EdgeOffsets<I>& o, Emit& emit,
+                                                       Region& region, Partial& partial_block) {
+  const EdgeExtents x = edge_extents(t, kBlockSize);
+  const int bx0 = area.x0 & ~(kBlockSize - 1), by0 = area.y0 & ~(kBlockSize - 1);
+  int64_t origin[3];
+  grid.at(bx0, by0, origin);
+  uint32_t outside = 0, cut = 0;
+  for (int g = 0; g < kGroups; ++g) {
+    U v[3];
+    for (int k = 0; k < 3; ++k) v[k] = (U{} + uint32_t(origin[k])) + (U(o.off[k][g]) << 2);
+    const U far =
+        (v[0] + uint32_t(x.hi[0])) | (v[1] + uint32_t(x.hi[1])) | (v[2] + uint32_t(x.hi[2]));
+    const U near =
+        (v[0] + uint32_t(x.lo[0])) | (v[1] + uint32_t(x.lo[1])) | (v[2] + uint32_t(x.lo[2]));
+    outside |= lane_bits(I(far)) << (g * kLanes);
+    cut |= lane_bits(I(near)) << (g * kLanes);
+  }
+  const int columns = (area.x1 - bx0 + kBlockSize - 1) / kBlockSize,
+            rows = (area.y1 - by0 + kBlockSize - 1) / kBlockSize;
+  const uint32_t reached = ~outside & block_rect_mask(0, columns, 0, rows);
+  for (uint32_t left = reached; left != 0; left &= left - 1) {
+    const int i = __builtin_ctz(left);
+    const int x = bx0 + kBlockSize * (i & 3), y = by0 + kBlockSize * (i >> 2);
+    if (((cut >> i) & 1u) == 0) {
+      emit(x, y, region(x, y));
+    } else {
+      int64_t e[3];
+      for (int k = 0; k < 3; ++k) {
+        e[k] = origin[k] + grid.step_x[k] * (x - bx0) + grid.step_y[k] * (y - by0);
+      }
+      partial_block(x, y, e);
+    }
+  }
+}
+
 template <Mode kMode, class V, class T>
 [[gnu::always_inline]] inline void raster_record_with(TileJob& job, const TriRecord& rec,
                                                       int32_t id, const PixelRect& area,
@@ -495,6 +536,12 @@ template <Mode kMode, class V, class T>
   // block's coverage directly, no classification; the edge values stepped from block to block
   // (the exact int64 sums grid.at gives).
   if (area.x1 - bx0 <= kMidBlockSize && area.y1 - by0 <= kMidBlockSize) {
+    if constexpr (sizeof(T) == 4) {
+      if ((area.x1 - bx0) * (area.y1 - by0) > 4 * kBlockSize * kBlockSize) {
+        raster_block_square(t, area, grid, offsets, emit, region, partial_block);
+        return;
+      }
+    }
     int64_t row[3];
     grid.at(bx0, by0, row);
     for (int y = by0; y < area.y1; y += kBlockSize) {
