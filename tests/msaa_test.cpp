@@ -72,8 +72,8 @@ TEST(Msaa, PerSampleCoverageFollowsTheFillRule) {
     const SamplePattern& p = *standard_sample_pattern(n);
     for (int round = 0; round < 1500; ++round) {
       detail::WindowVertex v[3];
-      // Every other triangle is up to 100 pixels across: past the 64-pixel bound of the 32-bit
-      // path, so both paths of the kernel are checked.
+      // Every other triangle is up to 190 pixels across, about half of them past the 120-pixel
+      // bound of the 32-bit path, so both paths of the kernel are checked.
       const int scale = round % 2 == 0 ? 1 : 6;
       for (auto& w : v)
         w = wv((coord(rng) * scale - 40 * (scale - 1)) * 16,

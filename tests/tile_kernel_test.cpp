@@ -150,6 +150,36 @@ TEST(TileKernel, CoverageEqualsTheEdgeEquationRasterizer) {
   EXPECT_GT(specks_checked, 200);  // the masks of specks, on both sides of tiles' edges
 }
 
+// Triangles whose vertices span exactly the 32-bit bound (kSmallTriangleFx8) in x and y, the
+// largest that take the int32 path, in the shapes that give its edge functions their largest
+// values over the blocks the kernels evaluate: right triangles with both legs at the bound, in
+// all four orientations, and slivers along either diagonal, at sub-pixel offsets that put their
+// corners on and off sample points and their bounds across tiles. Any value past int32 would
+// change a block's mask.
+TEST(TileKernel, TrianglesAtTheThirtyTwoBitBoundEqualTheEdgeEquationRasterizer) {
+  const int64_t s = detail::kSmallTriangleFx8;
+  const int width = 400, height = 300;
+  int checked = 0;
+  for (int64_t ox : {0, 1, 128, 255, 37 * 256 + 77}) {
+    for (int64_t oy : {0, 1, 128, 255, 21 * 256 + 200}) {
+      const int64_t x0 = 40 * 256 + ox, y0 = 30 * 256 + oy, x1 = x0 + s, y1 = y0 + s;
+      const detail::WindowVertex shapes[][3] = {
+          {vertex(x0, y0), vertex(x1, y0), vertex(x0, y1)},
+          {vertex(x1, y0), vertex(x1, y1), vertex(x0, y0)},
+          {vertex(x1, y1), vertex(x0, y1), vertex(x1, y0)},
+          {vertex(x0, y1), vertex(x0, y0), vertex(x1, y1)},
+          {vertex(x0, y0), vertex(x1, y1), vertex(x0 + 300, y0)},
+          {vertex(x0, y1), vertex(x1, y0), vertex(x1, y0 + 300)},
+      };
+      for (const auto& v : shapes) {
+        ASSERT_TRUE(agrees(v, width, height)) << "offset " << ox << "," << oy;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_EQ(checked, 150);
+}
+
 // The resolve kernels' depth is the fragment stage's (shade_block.hpp) to the bit, including
 // the clamp of values outside [0, 1], NaN and large gradients, and the test is LESS or LEQUAL.
 TEST(TileKernel, ResolveComputesTheFragmentStagesDepth) {

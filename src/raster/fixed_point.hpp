@@ -28,15 +28,17 @@ static_assert(kMaxCoordFx8 == (int64_t(1) << 23));
 static_assert((2 * kMaxCoordFx8) * kMaxCoordFx8 * 4 < (int64_t(1) << 62),
               "edge functions overflow");
 // The 32-bit coverage fast path. A triangle whose vertices span at most kSmallTriangleFx8 in x
-// and in y (64 pixels) has every edge function value at every sample of a 4x4 block that
+// and in y (120 pixels) has every edge function value at every sample of a 4x4 block that
 // overlaps its pixel bounds within int32. With (xi, yi) either vertex of the edge,
 //   E(p) = a (px - xi) + b (py - yi) (- 1 for the fill-rule bias), |a| = |dy| <= H, |b| = |dx| <= W
 // where W, H <= S = kSmallTriangleFx8 are the vertex extents; a block overlapping the bounds has
 // its samples within 3 pixels (768) of the extents, so |px - xi| < W + 4 * 256 and likewise y:
-//   |E| < 2 S (S + 1024) + 1 = 2^29 + 2^25 + 1 < 2^31.
-// The per-pixel offsets inside a block, |a| * 3 * 256 + |b| * 3 * 256 < 2^25, fit as well.
-// Larger triangles take the exact int64 path.
-inline constexpr int64_t kSmallTriangleFx8 = int64_t(1) << 14;
+//   |E| < 2 S (S + 1024) + 1 = 1,950,351,361 < 2^31.
+// The per-pixel offsets inside a block, |a| * 3 * 256 + |b| * 3 * 256 < 2^26, fit as well, and so
+// do the block offsets of a tile's row of blocks (tile_kernel.inl), 15 * 4 * 256 * |a| < 2^29.
+// Larger triangles take the exact int64 path. (The bound was 64 pixels; at 120, the larger
+// triangles of a textured ground plane near the camera, quad_grid's, take the faster path too.)
+inline constexpr int64_t kSmallTriangleFx8 = 120 * kSubpixelOne;
 static_assert(2 * kSmallTriangleFx8 * (kSmallTriangleFx8 + 4 * kSubpixelOne) + 1 <
                   (int64_t(1) << 31),
               "32-bit edge functions overflow");

@@ -33,7 +33,7 @@ struct SampleTriangle {
   int32_t vy[3] = {0, 0, 0};
   EdgeFunction edge[3];
   PixelRect bounds;
-  // Vertex extents of at most kSmallTriangleFx8 (64 pixels) in x and y: every edge function value
+  // Vertex extents of at most kSmallTriangleFx8 (120 pixels) in x and y: every edge function value
   // at the samples of a block that meets `bounds` fits in int32 (sample_coverage.cpp).
   bool small = false;
 };
