@@ -532,9 +532,10 @@ template <Mode kMode, class V, class T>
     uint32_t bits = coverage_bits<V, T>(e, offsets) & region(x, y);
     if (bits != 0) emit(x, y, bits);
   };
-  // Small areas (at most 16x16 pixels of blocks, the usual triangle of a dense mesh): every
-  // block's coverage directly, no classification; the edge values stepped from block to block
-  // (the exact int64 sums grid.at gives).
+  // Small areas (at most 16x16 pixels of blocks, the usual triangle of a dense mesh): past 2x2
+  // blocks, a triangle on the 32-bit path has them classified at once (raster_block_square);
+  // otherwise every block's coverage directly, no classification, the edge values stepped from
+  // block to block (the exact int64 sums grid.at gives).
   if (area.x1 - bx0 <= kMidBlockSize && area.y1 - by0 <= kMidBlockSize) {
     if constexpr (sizeof(T) == 4) {
       if ((area.x1 - bx0) * (area.y1 - by0) > 4 * kBlockSize * kBlockSize) {
