@@ -393,86 +393,88 @@ struct EdgeGrid {
   }
 };
 
-// The blocks of a small triangle's area (the 32-bit bound of fixed_point.hpp holds) a row of
-// blocks at a time: the row's blocks, at most 16 inside a tile, are the lanes of kGroups vectors,
-// and one pass of additions and sign masks tells which lie outside an edge and which inside all
-// three (classify's test, exactly, at every block of the row), so that only blocks the triangle
-// reaches are visited. (Block by block, the hierarchical walk below spent about 9 % of diablo3's
-// frame classifying blocks, most of them outside a medium triangle's edges, on branches that its
-// varying shapes make unpredictable.)
+// The blocks of a small triangle's area (the 32-bit bound of fixed_point.hpp holds) classified
+// several at once: each block is a lane of kGroups vectors, and one pass of additions and sign
+// masks tells which lie outside an edge and which some edge cuts (classify's test, exactly, at
+// every block), so that only the blocks the triangle reaches are visited. (Block by block, the
+// hierarchical walk below spent about 9 % of diablo3's frame classifying blocks, most of them
+// outside a medium triangle's edges, on branches that its varying shapes make unpredictable.)
 //
-// Every value is a sample value of a block that overlaps the area, so it fits in int32 (the
-// lanes past the area's last column are computed in unsigned arithmetic, wrapping harmlessly,
-// and masked off).
+// Every value of a lane whose block overlaps the area is a sample value of that block, so it fits
+// in int32; the other lanes are computed in unsigned arithmetic, wrapping harmlessly, and masked
+// off.
 typedef uint32_t U __attribute__((vector_size(4 * kLanes)));
 
-struct BlockRows {
-  U column[3][kGroups];   // E's change from the row's first block to the lane's block
-  uint32_t lo[3], hi[3];  // added to E at a block's first sample: its minimum and maximum
-  uint32_t step[3];       // E's change from one block to the next right
-  uint32_t row_step[3];   // E's change from one row of blocks to the next
-};
+// Adds group g's bits to `outside` (the lanes' blocks outside an edge) and `cut` (those some edge
+// cuts); `v`: E at each lane's block's first sample, `x` the block's extents.
+[[gnu::always_inline]] inline void classify_lanes(const U v[3], const EdgeExtents& x, int g,
+                                                  uint32_t& outside, uint32_t& cut) {
+  const U far =
+      (v[0] + uint32_t(x.hi[0])) | (v[1] + uint32_t(x.hi[1])) | (v[2] + uint32_t(x.hi[2]));
+  const U near =
+      (v[0] + uint32_t(x.lo[0])) | (v[1] + uint32_t(x.lo[1])) | (v[2] + uint32_t(x.lo[2]));
+  outside |= lane_bits(I(far)) << (g * kLanes);
+  cut |= lane_bits(I(near)) << (g * kLanes);
+}
 
-[[gnu::always_inline]] inline void block_rows(const TriRecord& t, BlockRows& r) {
-  const EdgeExtents x = edge_extents(t, kBlockSize);
-  for (int k = 0; k < 3; ++k) {
-    const uint32_t step = uint32_t(t.edge[k].a * (kSubpixelOne * kBlockSize));
-    r.step[k] = step;
-    for (int g = 0; g < kGroups; ++g) r.column[k][g] = U(pixel_index(g)) * step;
-    r.lo[k] = uint32_t(x.lo[k]);
-    r.hi[k] = uint32_t(x.hi[k]);
-    r.row_step[k] = uint32_t(t.edge[k].b * (kSubpixelOne * kBlockSize));
+// The blocks of `reached`: bit i the block at(i) (a pair of x and y), emitted whole unless `cut`
+// has it, then through partial_block with the edge values at_block(i, e) gives.
+template <class At, class Values, class Emit, class Region, class Partial>
+[[gnu::always_inline]] inline void visit_reached(uint32_t reached, uint32_t cut, const At& at,
+                                                 const Values& at_block, Emit& emit, Region& region,
+                                                 Partial& partial_block) {
+  for (uint32_t left = reached; left != 0; left &= left - 1) {
+    const int i = __builtin_ctz(left);
+    const auto [x, y] = at(i);
+    if (((cut >> i) & 1u) == 0) {
+      emit(x, y, region(x, y));
+    } else {
+      int64_t e[3];
+      at_block(i, e);
+      partial_block(x, y, e);
+    }
   }
 }
 
-// Bits of the row's blocks (bit i: the block i columns right of the first) that lie outside an
-// edge (`outside`) and that some edge cuts (`cut`); `e`: E at the first block's first sample.
-[[gnu::always_inline]] inline void classify_row(const BlockRows& r, const uint32_t e[3],
-                                                uint32_t& outside, uint32_t& cut) {
-  outside = 0;
-  cut = 0;
-  for (int g = 0; g < kGroups; ++g) {
-    const U v0 = (U{} + e[0]) + r.column[0][g], v1 = (U{} + e[1]) + r.column[1][g],
-            v2 = (U{} + e[2]) + r.column[2][g];
-    outside |= lane_bits(I((v0 + r.hi[0]) | (v1 + r.hi[1]) | (v2 + r.hi[2]))) << (g * kLanes);
-    cut |= lane_bits(I((v0 + r.lo[0]) | (v1 + r.lo[1]) | (v2 + r.lo[2]))) << (g * kLanes);
-  }
-}
-
+// An area wider or taller than 4x4 blocks, a row of blocks at a time (at most 16 in a tile).
 template <class Emit, class Region, class Partial>
 [[gnu::always_inline]] inline void raster_block_rows(const TriRecord& t, const PixelRect& area,
                                                      const EdgeGrid& grid, Emit& emit,
                                                      Region& region, Partial& partial_block) {
-  BlockRows rows;
-  block_rows(t, rows);
+  const EdgeExtents x = edge_extents(t, kBlockSize);
+  U column[3][kGroups];           // E's change from the row's first block to the lane's block
+  uint32_t step[3], row_step[3];  // E's change to the next block right, and down
+  for (int k = 0; k < 3; ++k) {
+    step[k] = uint32_t(t.edge[k].a * (kSubpixelOne * kBlockSize));
+    row_step[k] = uint32_t(t.edge[k].b * (kSubpixelOne * kBlockSize));
+    for (int g = 0; g < kGroups; ++g) column[k][g] = U(pixel_index(g)) * step[k];
+  }
   const int bx0 = area.x0 & ~(kBlockSize - 1), by0 = area.y0 & ~(kBlockSize - 1);
   const int columns = (area.x1 - bx0 + kBlockSize - 1) / kBlockSize;  // at most 16 in a tile
-  const uint32_t in_area = (1u << columns) - 1u;
   int64_t row[3];
   grid.at(bx0, by0, row);
   uint32_t e_row[3] = {uint32_t(row[0]), uint32_t(row[1]), uint32_t(row[2])};
   for (int y = by0; y < area.y1; y += kBlockSize) {
-    uint32_t outside, cut;
-    classify_row(rows, e_row, outside, cut);
-    const uint32_t reached = ~outside & in_area;
-    for (uint32_t left = reached; left != 0; left &= left - 1) {
-      const int i = __builtin_ctz(left);
-      const int x = bx0 + kBlockSize * i;
-      if (((cut >> i) & 1u) == 0) {
-        emit(x, y, region(x, y));
-      } else {
-        int64_t e[3];
-        for (int k = 0; k < 3; ++k) e[k] = int32_t(e_row[k] + uint32_t(i) * rows.step[k]);
-        partial_block(x, y, e);
-      }
+    uint32_t outside = 0, cut = 0;
+    for (int g = 0; g < kGroups; ++g) {
+      const U v[3] = {(U{} + e_row[0]) + column[0][g], (U{} + e_row[1]) + column[1][g],
+                      (U{} + e_row[2]) + column[2][g]};
+      classify_lanes(v, x, g, outside, cut);
     }
-    for (int k = 0; k < 3; ++k) e_row[k] += rows.row_step[k];
+    visit_reached(
+        ~outside & ((1u << columns) - 1u), cut,
+        [&](int i) { return std::pair<int, int>(bx0 + kBlockSize * i, y); },
+        [&](int i, int64_t e[3]) {
+          for (int k = 0; k < 3; ++k) e[k] = int32_t(e_row[k] + uint32_t(i) * step[k]);
+        },
+        emit, region, partial_block);
+    for (int k = 0; k < 3; ++k) e_row[k] += row_step[k];
   }
 }
 
-// The same for an area of at most 4x4 blocks (16x16 pixels): all its blocks classified at once,
-// lane p of the kGroups vectors the block p & 3 columns right and p >> 2 rows down of the first
-// (pixel_index's layout, in blocks: the pixel offsets `o` times 4).
+// An area of at most 4x4 blocks (16x16 pixels), all its blocks at once: lane p the block p & 3
+// columns right and p >> 2 rows down of the first (pixel_index's layout, in blocks: the pixel
+// offsets `o` times 4).
 template <class Emit, class Region, class Partial>
 [[gnu::always_inline]] inline void raster_block_square(const TriRecord& t, const PixelRect& area,
                                                        const EdgeGrid& grid,
@@ -486,29 +488,22 @@ template <class Emit, class Region, class Partial>
   for (int g = 0; g < kGroups; ++g) {
     U v[3];
     for (int k = 0; k < 3; ++k) v[k] = (U{} + uint32_t(origin[k])) + (U(o.off[k][g]) << 2);
-    const U far =
-        (v[0] + uint32_t(x.hi[0])) | (v[1] + uint32_t(x.hi[1])) | (v[2] + uint32_t(x.hi[2]));
-    const U near =
-        (v[0] + uint32_t(x.lo[0])) | (v[1] + uint32_t(x.lo[1])) | (v[2] + uint32_t(x.lo[2]));
-    outside |= lane_bits(I(far)) << (g * kLanes);
-    cut |= lane_bits(I(near)) << (g * kLanes);
+    classify_lanes(v, x, g, outside, cut);
   }
   const int columns = (area.x1 - bx0 + kBlockSize - 1) / kBlockSize,
             rows = (area.y1 - by0 + kBlockSize - 1) / kBlockSize;
-  const uint32_t reached = ~outside & block_rect_mask(0, columns, 0, rows);
-  for (uint32_t left = reached; left != 0; left &= left - 1) {
-    const int i = __builtin_ctz(left);
-    const int x = bx0 + kBlockSize * (i & 3), y = by0 + kBlockSize * (i >> 2);
-    if (((cut >> i) & 1u) == 0) {
-      emit(x, y, region(x, y));
-    } else {
-      int64_t e[3];
-      for (int k = 0; k < 3; ++k) {
-        e[k] = origin[k] + grid.step_x[k] * (x - bx0) + grid.step_y[k] * (y - by0);
-      }
-      partial_block(x, y, e);
-    }
-  }
+  const auto at = [&](int i) {
+    return std::pair<int, int>(bx0 + kBlockSize * (i & 3), by0 + kBlockSize * (i >> 2));
+  };
+  visit_reached(
+      ~outside & block_rect_mask(0, columns, 0, rows), cut, at,
+      [&](int i, int64_t e[3]) {
+        const auto [bx, by] = at(i);
+        for (int k = 0; k < 3; ++k) {
+          e[k] = origin[k] + grid.step_x[k] * (bx - bx0) + grid.step_y[k] * (by - by0);
+        }
+      },
+      emit, region, partial_block);
 }
 
 template <Mode kMode, class V, class T>
