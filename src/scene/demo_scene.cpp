@@ -3,6 +3,7 @@
 // a torus, a box cut by the image border, all lit by the phong shader.
 #include <cmath>
 #include <functional>
+#include <vector>
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
@@ -14,13 +15,40 @@ namespace {
 
 constexpr float kPi = glm::pi<float>();
 
-// A procedural texture: colour as a function of the texel's (u, v) in [0, 1).
+// A procedural texture: colour as a function of (u, v) in [0, 1). A texel is the pattern's mean
+// over its square: 4 x 4 samples where the pattern changes inside it (its four corners and its
+// centre are not all one colour), else that one colour. The patterns' edges then come out
+// anti-aliased, as a painted texture's would, instead of as steps one texel wide (which the
+// bilinear filter magnified into jagged stripes on the sphere and the torus).
 Texture make_texture(int size, const std::function<glm::vec3(float, float)>& f) {
+  constexpr int kSub = 4;
+  const int side = size + 1;
+  // Row 0 of the image is the top, v = 1; corner (x, y) is the top-left corner of texel (x, y).
+  std::vector<glm::vec3> corner(std::size_t(side) * side);
+  for (int y = 0; y < side; ++y) {
+    for (int x = 0; x < side; ++x) {
+      corner[std::size_t(y) * side + x] = f(float(x) / size, 1.0f - float(y) / size);
+    }
+  }
   Image image(size, size);
   for (int y = 0; y < size; ++y) {
     for (int x = 0; x < size; ++x) {
-      // Row 0 of the image is the top, v = 1.
+      const glm::vec3 c00 = corner[std::size_t(y) * side + x];
       glm::vec3 c = f((x + 0.5f) / size, 1.0f - (y + 0.5f) / size);
+      if (c != c00 || corner[std::size_t(y) * side + x + 1] != c00 ||
+          corner[std::size_t(y + 1) * side + x] != c00 ||
+          corner[std::size_t(y + 1) * side + x + 1] != c00) {
+        glm::vec3 sum(0.0f);
+        bool uniform = true;  // a texel that an edge only touches keeps its colour exactly
+        for (int j = 0; j < kSub; ++j) {
+          for (int i = 0; i < kSub; ++i) {
+            glm::vec3 v = f((x + (i + 0.5f) / kSub) / size, 1.0f - (y + (j + 0.5f) / kSub) / size);
+            uniform = uniform && v == c;
+            sum += v;
+          }
+        }
+        if (!uniform) c = sum / float(kSub * kSub);
+      }
       uint8_t* p = image.pixel(x, y);
       p[0] = to_unorm8(c.r), p[1] = to_unorm8(c.g), p[2] = to_unorm8(c.b), p[3] = 255;
     }
@@ -142,9 +170,9 @@ DemoScene make_demo_scene() {
   DemoScene scene;
   Mesh& mesh = scene.mesh;
   int floor_mat = add_material(mesh, "floor", {0.55f, 0.58f, 0.6f}, make_texture(256, checker));
-  int stripe_mat = add_material(mesh, "stripes", {0.92f, 0.58f, 0.25f}, make_texture(128, stripes));
-  int brick_mat = add_material(mesh, "bricks", {0.65f, 0.3f, 0.22f}, make_texture(128, bricks));
-  int ring_mat = add_material(mesh, "rings", {0.45f, 0.7f, 0.92f}, make_texture(128, rings));
+  int stripe_mat = add_material(mesh, "stripes", {0.92f, 0.58f, 0.25f}, make_texture(256, stripes));
+  int brick_mat = add_material(mesh, "bricks", {0.65f, 0.3f, 0.22f}, make_texture(256, bricks));
+  int ring_mat = add_material(mesh, "rings", {0.45f, 0.7f, 0.92f}, make_texture(256, rings));
 
   // Floor: y = 0 from z = +12 (behind the camera) to z = -30, 4 x 4 quads so that some triangles
   // straddle the near plane and some lie wholly behind the camera.
