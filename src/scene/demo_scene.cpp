@@ -24,20 +24,19 @@ Texture make_texture(int size, const std::function<glm::vec3(float, float)>& f) 
   constexpr int kSub = 4;
   const int side = size + 1;
   // Row 0 of the image is the top, v = 1; corner (x, y) is the top-left corner of texel (x, y).
-  std::vector<glm::vec3> corner(std::size_t(side) * side);
+  std::vector<glm::vec3> corners(std::size_t(side) * side);
+  const auto corner = [&](int x, int y) -> glm::vec3& {
+    return corners[std::size_t(y) * side + x];
+  };
   for (int y = 0; y < side; ++y) {
-    for (int x = 0; x < side; ++x) {
-      corner[std::size_t(y) * side + x] = f(float(x) / size, 1.0f - float(y) / size);
-    }
+    for (int x = 0; x < side; ++x) corner(x, y) = f(float(x) / size, 1.0f - float(y) / size);
   }
   Image image(size, size);
   for (int y = 0; y < size; ++y) {
     for (int x = 0; x < size; ++x) {
-      const glm::vec3 c00 = corner[std::size_t(y) * side + x];
       glm::vec3 c = f((x + 0.5f) / size, 1.0f - (y + 0.5f) / size);
-      if (c != c00 || corner[std::size_t(y) * side + x + 1] != c00 ||
-          corner[std::size_t(y + 1) * side + x] != c00 ||
-          corner[std::size_t(y + 1) * side + x + 1] != c00) {
+      if (corner(x, y) != c || corner(x + 1, y) != c || corner(x, y + 1) != c ||
+          corner(x + 1, y + 1) != c) {
         glm::vec3 sum(0.0f);
         bool uniform = true;  // a texel that an edge only touches keeps its colour exactly
         for (int j = 0; j < kSub; ++j) {
