@@ -88,6 +88,34 @@ TEST_F(GltfTest, GltfAndGlbOfOneSceneRenderIdentically) {
   EXPECT_GT(white, 50);
 }
 
+// KHR_texture_transform, the extension's own example: offset (0, 1), rotation pi/2 and scale 0.5
+// "utilizes only the lower left quadrant of the source image, rotated clockwise 90 degrees". In
+// glTF's uvs (v down) the surface's point (u, v) reads the image at (v / 2, 1 - u / 2): the
+// surface's top-left corner shows the quadrant's bottom-left one. (Khronos's
+// TextureTransformTest model turns the same way: its arrows point at the green markers.)
+// softrast's uvs have v up: (u, v) here is glTF's (u, 1 - v).
+TEST_F(GltfTest, TextureTransformTurnsAsTheExtensionsExampleSays) {
+  GltfParts cube = test::textured_cube(png_);
+  cube.json["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {
+      {"KHR_texture_transform",
+       {{"offset", {0.0, 1.0}}, {"rotation", 1.5707963267948966}, {"scale", {0.5, 0.5}}}}};
+  cube.json["extensionsUsed"] = {"KHR_texture_transform"};
+  Result<Mesh> mesh = load_model(write("transformed.gltf", test::as_gltf(cube)));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  ASSERT_TRUE(mesh->materials[0].pbr.has_value());
+  const TextureSlot& slot = mesh->materials[0].pbr->base_color_map;
+  ASSERT_TRUE(slot.transformed);
+  for (float u : {0.0f, 0.25f, 1.0f}) {
+    for (float v : {0.0f, 0.5f, 0.9f}) {
+      const float gu = u, gv = 1.0f - v;  // glTF's uv of the surface point
+      const float image_u = gv / 2.0f, image_v = 1.0f - gu / 2.0f;  // where it reads, glTF's uv
+      const glm::vec3 p(u, v, 1.0f);
+      EXPECT_NEAR(glm::dot(slot.u_row, p), image_u, 1e-5f) << u << ", " << v;
+      EXPECT_NEAR(glm::dot(slot.v_row, p), 1.0f - image_v, 1e-5f) << u << ", " << v;
+    }
+  }
+}
+
 // Node 0 translates by (0.25, 0, 0); its child node 1 turns by 30 degrees about y and scales by
 // 0.8: every loaded corner is T * R * S of a corner of the unit cube.
 TEST_F(GltfTest, NodeTransformsPlaceEveryVertex) {

@@ -357,8 +357,12 @@ void apply_texture_transform(const tg::ExtensionMap& extensions, TextureSlot& sl
   double tex_coord = number(t, "texCoord", -1.0);
   if (tex_coord == 0.0 || tex_coord == 1.0) slot.uv_set = int(tex_coord);
   float c = std::cos(rotation), s = std::sin(rotation);
-  // A = R * S with R's columns (c, s) and (-s, c), the extension's GLSL.
-  float a00 = c * scale.x, a01 = -s * scale.y, a10 = s * scale.x, a11 = c * scale.y;
+  // A = R * S with R = [c s; -s c] (rows): uv' = (c u + s v, -s u + c v) before the offset.
+  // This is the direction the extension's examples and Khronos's TextureTransformTest model
+  // require ("offset [0, 1], rotation pi/2, scale 0.5: the lower left quadrant, rotated
+  // clockwise 90 degrees"); the GLSL snippet of the extension's text, read as GLSL's
+  // column-major mat3, turns the other way (the sample model's red marker).
+  float a00 = c * scale.x, a01 = s * scale.y, a10 = -s * scale.x, a11 = c * scale.y;
   // uv' = D A D uv + D (A (0, 1) + offset) + (0, 1), D = diag(1, -1).
   slot.u_row = {a00, -a01, a01 + offset.x};
   slot.v_row = {-a10, a11, 1.0f - (a11 + offset.y)};
