@@ -4,8 +4,9 @@
 // 99999999999999999999 or 4294967299 became some other index silently, its number parser
 // overflows an int on an exponent such as 1e2147483648, and holding its per-corner arrays beside
 // the whole text took 1.83 GB for an 80 MB file. MTL files still go to tinyobj's LoadMtl
-// (io/mtl_materials.cpp). Also ours: the fan triangulation (tinyobj splits quads along the
-// shorter diagonal).
+// (io/mtl_materials.cpp). Also ours: the triangulation (geometry/polygon.hpp: the fan of a convex
+// face, as SCENES.md's pipeline has it, where tinyobj splits quads along the shorter diagonal;
+// ear clipping of a concave one).
 //
 // In parallel, in bounded memory: the file is read in pieces of about 1 MiB cut at line ends;
 // worker threads parse pieces (io/obj_piece.cpp) while this thread reads on and merges finished
@@ -44,6 +45,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include "geometry/polygon.hpp"
 #include "io/mtl_materials.hpp"
 #include "io/obj_piece.hpp"
 #include "io/text_lines.hpp"
@@ -230,6 +232,9 @@ class ObjMerge {
   }
   void add_faces(const ObjPiece& piece, const size_t offset[3], size_t end_face,
                  std::vector<uint32_t>& indices);
+  template <class KeyOf>
+  void add_polygon(const ObjCorner* c, size_t n, const KeyOf& key_of,
+                   std::vector<uint32_t>& indices);
   Mesh build_mesh();
 
   const std::string& path_;
@@ -244,6 +249,9 @@ class ObjMerge {
   std::vector<SubMesh> submeshes_;
   int material_ = -1;
   size_t face_ = 0, corner_ = 0;  // cursor in the piece being merged
+  // add_polygon's scratch: a face's vertices, positions and triangles (as corner numbers).
+  std::vector<uint32_t> polygon_vertices_, polygon_triangles_;
+  std::vector<glm::vec3> polygon_points_;
   size_t pieces_ = 0;
 };
 
@@ -270,7 +278,35 @@ Status ObjMerge::first_fixup_error(ObjPiece& piece, const size_t offset[3], size
   return {};
 }
 
-// Fans faces [face_, end_face) of the piece around their first corner: (0, 1, 2), (0, 2, 3), ...
+// A face of n > 3 corners: its vertices in corner order (so numbered as they are met), its
+// triangles from triangulate_polygon (the fan of a convex face; a concave one clipped into ears).
+// A face naming a position not read yet (OBJ allows it) is fanned.
+template <class KeyOf>
+void ObjMerge::add_polygon(const ObjCorner* c, size_t n, const KeyOf& key_of,
+                           std::vector<uint32_t>& indices) {
+  polygon_vertices_.clear();
+  polygon_points_.clear();
+  bool positioned = true;
+  for (size_t k = 0; k < n; ++k) {
+    VertexTable::Key key = key_of(c[k]);
+    polygon_vertices_.push_back(table_.vertex(key));
+    positioned = positioned && size_t(key.v) < values_[0].count();
+    if (positioned) {
+      const float* p = values_[0].at(size_t(key.v));
+      polygon_points_.emplace_back(p[0], p[1], p[2]);
+    }
+  }
+  polygon_triangles_.clear();
+  if (positioned) {
+    detail::triangulate_polygon(polygon_points_.data(), n, polygon_triangles_);
+  } else {
+    for (uint32_t k = 2; k < n; ++k)
+      polygon_triangles_.insert(polygon_triangles_.end(), {0, k - 1, k});
+  }
+  for (uint32_t corner : polygon_triangles_) indices.push_back(polygon_vertices_[corner]);
+}
+
+// Adds faces [face_, end_face) of the piece: a triangle as it is, a polygon by add_polygon.
 void ObjMerge::add_faces(const ObjPiece& piece, const size_t offset[3], size_t end_face,
                          std::vector<uint32_t>& indices) {
   auto key_of = [&](const ObjCorner& c) {
@@ -287,12 +323,11 @@ void ObjMerge::add_faces(const ObjPiece& piece, const size_t offset[3], size_t e
       submeshes_.push_back({uint32_t(index_count_ + indices.size()), 0, material_});
     }
     const ObjCorner* c = &piece.corners[corner_];
-    uint32_t first = table_.vertex(key_of(c[0]));
-    uint32_t previous = table_.vertex(key_of(c[1]));
-    for (size_t k = 2; k < n; ++k) {
-      uint32_t current = table_.vertex(key_of(c[k]));
-      indices.insert(indices.end(), {first, previous, current});
-      previous = current;
+    if (n == 3) {
+      indices.insert(indices.end(), {table_.vertex(key_of(c[0])), table_.vertex(key_of(c[1])),
+                                     table_.vertex(key_of(c[2]))});
+    } else {
+      add_polygon(c, n, key_of, indices);
     }
     submeshes_.back().index_count += uint32_t(3 * (n - 2));
     corner_ += n;

@@ -7,8 +7,9 @@
 // texture_s, texture_t; red, green, blue (and alpha; also r, g, b, a and diffuse_red, ...) as
 // vertex colours, integers scaled by their type's largest value (255 for uchar), floats as they
 // are, both clamped to [0, 1]; any other property is read and dropped. The face element's
-// vertex_indices (or vertex_index) list, of any integer types, fan-triangulated. Other elements
-// (edges, materials, ...) are read past.
+// vertex_indices (or vertex_index) list, of any integer types, cut into triangles as
+// geometry/polygon.hpp says (the fan of a convex face, ear clipping of a concave one). Other
+// elements (edges, materials, ...) are read past.
 //
 // Robustness: every element count is checked against the bytes left before anything is reserved
 // (a binary element has a known minimum size; an ASCII value takes at least two bytes), list
@@ -29,6 +30,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "geometry/polygon.hpp"
 #include "io/model_formats.hpp"
 
 namespace softrast::detail {
@@ -522,6 +524,8 @@ class PlyBuilder {
   uint64_t vertex_count_ = 0;
   bool has_normals_ = false, has_uvs_ = false, has_colors_ = false;
   std::vector<uint32_t> corners_;
+  std::vector<glm::vec3> points_;    // the face's corners' positions
+  std::vector<uint32_t> triangles_;  // its triangles, as corner numbers
 };
 
 bool PlyBuilder::read_vertex(const Element& e, size_t index) {
@@ -595,9 +599,13 @@ bool PlyBuilder::read_face(const Element& e, const Property& indices, size_t fac
     if (mesh_.indices.size() + 3 * (corners_.size() - 2) > UINT32_MAX) {
       return body_.fail("too many faces");
     }
-    for (size_t k = 2; k < corners_.size(); ++k) {
-      mesh_.indices.insert(mesh_.indices.end(), {corners_[0], corners_[k - 1], corners_[k]});
-    }
+    // Triangles as geometry/polygon.hpp cuts the face (the fan of a convex one). A face read
+    // before the vertices (an element order PLY allows) sees them all at the origin: the fan.
+    points_.clear();
+    for (uint32_t corner : corners_) points_.push_back(mesh_.positions[corner]);
+    triangles_.clear();
+    detail::triangulate_polygon(points_.data(), points_.size(), triangles_);
+    for (uint32_t k : triangles_) mesh_.indices.push_back(corners_[k]);
   }
   return true;
 }
