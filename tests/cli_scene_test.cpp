@@ -278,6 +278,22 @@ TEST(CliFraming, EveryViewFillsTheLimitingSide) {
   }
 }
 
+// A model flat across the view (a square in the plane x = 0) is seen from the right unless a view
+// is asked for: from the front it is an edge, a line or no pixel at all (assimp's
+// concave_polygon.obj, a ring in such a plane, drew an empty image).
+TEST(CliFraming, ModelFlatAcrossTheViewIsSeenFaceOn) {
+  CliFolder folder;
+  folder.write("wall.obj", "v 0 -1 -1\nv 0 -1 1\nv 0 1 1\nv 0 1 -1\nf 1 2 3 4\n");
+  for (const char* up : {"+y", "+z"}) {
+    std::string args =
+        std::string("wall.obj --shader flat --background 0,0,0 --size 120x120 --up-axis ") + up;
+    expect_framed(folder.render(args), args);
+  }
+  Extent edge = model_extent(
+      folder.render("wall.obj --shader flat --background 0,0,0 --size 120x120 --view front"));
+  EXPECT_LE(edge.right - edge.left, 2) << "--view front is still the front";
+}
+
 TEST(CliFraming, AnglesUpAxesAndZoom) {
   CliFolder folder;
   folder.write("part.obj", long_part_obj());

@@ -43,7 +43,8 @@ void define_camera_flags(CLI::App& app, RawArgs& a) {
       ->type_name("AXIS");
   app.add_option("--view", a.view,
                  "Side the model is seen from: front, back, left, right, top, bottom or iso "
-                 "(default front, or from 45 degrees above a model flat along its up axis)")
+                 "(default front; from 45 degrees above a model flat along its up axis, and "
+                 "right for one flat across the view, which the front would see edge-on)")
       ->type_name("NAME");
   app.add_option("--azimuth", a.azimuth,
                  "Camera angle around the up axis, from the front towards the right (default: "

@@ -102,12 +102,19 @@ bool flat_along(const Mesh& mesh, glm::vec3 axis) {
   return size[a] < kFlatRatio * std::min(size[(a + 1) % 3], size[(a + 2) % 3]);
 }
 
-// The orientation to frame from: the flags' angles, else the front, from 45 degrees above for a
-// model flat along its up axis (seen edge-on otherwise).
+// The orientation to frame from: the flags' angles, else the front; from 45 degrees above for a
+// model flat along its up axis, and from the right for one flat along its right axis (a sign, a
+// polygon standing across the view): either would be seen edge-on from the front, as a line.
 Orientation orientation_for(const Mesh& mesh, const CameraFlags& flags) {
   Orientation o;
-  bool flat = !flags.azimuth && !flags.elevation && flat_along(mesh, flags.up_axis);
-  if (flat) o.elevation = 45.0f;
+  if (!flags.azimuth && !flags.elevation) {
+    const ModelFrame m = model_frame(flags.up_axis);
+    if (flat_along(mesh, m.up)) {
+      o.elevation = 45.0f;
+    } else if (flat_along(mesh, m.right)) {
+      o.azimuth = 90.0f;
+    }
+  }
   if (flags.azimuth) o.azimuth = *flags.azimuth;
   if (flags.elevation) o.elevation = *flags.elevation;
   return o;
@@ -276,6 +283,7 @@ Bounds bounds_of(const Mesh& mesh) {
   bounds.center = center_of(mesh);
   bounds.radius = radius_of(mesh, bounds.center);
   bounds.flat_in_y = flat_along(mesh, glm::vec3(0.0f, 1.0f, 0.0f));
+  bounds.flat_in_x = !bounds.flat_in_y && flat_along(mesh, glm::vec3(1.0f, 0.0f, 0.0f));
   return bounds;
 }
 
@@ -289,8 +297,9 @@ Camera frame_model(const Bounds& bounds, const CameraFlags& flags, float aspect)
     float half_x = std::atan(std::tan(half_y) * aspect);
     distance = bounds.radius / std::sin(std::min(half_y, half_x));
   }
-  glm::vec3 direction =
-      bounds.flat_in_y ? glm::normalize(glm::vec3(0.0f, 1.0f, 1.0f)) : glm::vec3(0.0f, 0.0f, 1.0f);
+  glm::vec3 direction = bounds.flat_in_y   ? glm::normalize(glm::vec3(0.0f, 1.0f, 1.0f))
+                        : bounds.flat_in_x ? glm::vec3(1.0f, 0.0f, 0.0f)
+                                           : glm::vec3(0.0f, 0.0f, 1.0f);
   camera.eye = flags.eye.value_or(camera.target + direction * distance);
   if (!flags.up)
     camera.up = default_up(camera, camera.up, model_frame(glm::vec3(0.0f, 1.0f, 0.0f)));

@@ -51,12 +51,14 @@ struct Bounds {
   glm::vec3 center{0.0f};
   float radius = 1.0f;
   bool flat_in_y = false;  // height under a tenth of the width and depth: a ground plane
+  bool flat_in_x = false;  // else width under a tenth of the height and depth: a wall across
 };
 Bounds bounds_of(const Mesh& mesh);
 
-// The bounding sphere's framing: from +z (45 degrees up for a model flat in y) at the distance
-// where the sphere fits the narrower field of view; with the eye and target given, only near and
-// far (around the sphere) are chosen. Looser than frame_model(mesh) above.
+// The bounding sphere's framing: from +z (45 degrees up for a model flat in y, from +x for one
+// flat in x) at the distance where the sphere fits the narrower field of view; with the eye and
+// target given, only near and far (around the sphere) are chosen. Looser than frame_model(mesh)
+// above.
 Camera frame_model(const Bounds& bounds, const CameraFlags& flags, float aspect);
 
 // Replaces the settings of `camera` that `flags` gives.
