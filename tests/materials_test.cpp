@@ -115,6 +115,28 @@ TEST(Materials, MtlStatementsAndMapsAreRead) {
   EXPECT_EQ(mesh->tangents.size(), mesh->positions.size());
 }
 
+// Material names with spaces (assimp's space_in_material_name.obj, from LightWave): newmtl's name
+// is the rest of its line, and usemtl names it with the same words, however spaced; a usemtl of
+// more words than a one-word newmtl still finds it by its first word, as before.
+TEST(Materials, NamesWithSpacesAreFound) {
+  Folder f;
+  f.write("a.obj", std::string("mtllib a.mtl\n") + kQuadObj +
+                       "usemtl  Hard Shiny   Plastic White \nf 1/1/1 2/2/1 3/3/1\n"
+                       "usemtl red extra words\nf 1/1/1 3/3/1 4/4/1\n");
+  f.write(
+      "a.mtl",
+      "newmtl red\nKd 1 0 0\nnewmtl Hard Shiny Plastic White \nKd 0.141176 0.184314 0.411765\n");
+  Result<Mesh> mesh = load_obj(f.path("a.obj"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  EXPECT_TRUE(mesh->warnings.empty()) << mesh->warnings[0];
+  ASSERT_EQ(mesh->submeshes.size(), 2u);
+  ASSERT_GE(mesh->submeshes[0].material, 0);
+  ASSERT_GE(mesh->submeshes[1].material, 0);
+  EXPECT_EQ(mesh->materials[size_t(mesh->submeshes[0].material)].diffuse,
+            glm::vec3(0.141176f, 0.184314f, 0.411765f));
+  EXPECT_EQ(mesh->materials[size_t(mesh->submeshes[1].material)].diffuse, glm::vec3(1, 0, 0));
+}
+
 TEST(Materials, BadMtlValuesAreErrorsAndMissingMapsWarnings) {
   Folder f;
   f.write("a.obj", std::string("mtllib a.mtl\n") + kQuadObj + "usemtl m\nf 1/1/1 2/2/1 3/3/1\n");

@@ -189,12 +189,26 @@ Status ObjMaterials::load_library(const std::string& name, const std::string& ob
   std::istringstream in(text);
   std::string warn;
   tinyobj::LoadMtl(&ids_, &all_, &in, &warn, nullptr);
+  for (const auto& [material, index] : ids_) {
+    auto [it, added] = spaced_ids_.emplace(words_of(material), index);
+    if (!added) it->second = std::min(it->second, index);
+  }
   std::vector<MtlGiven> given = scan_given(text);
   // Should the scan ever disagree with tinyobj, trust tinyobj's values.
   given.resize(all_.size() - first, MtlGiven{true, true, true});
   given_.insert(given_.end(), given.begin(), given.end());
   dirs_.resize(all_.size(), path.parent_path());
   return {};
+}
+
+std::string ObjMaterials::words_of(const std::string& name) {
+  std::string out;
+  ObjWords words(name);
+  for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
+    if (!out.empty()) out += ' ';
+    out.append(w);
+  }
+  return out;
 }
 
 int ObjMaterials::use(const std::string& name, const std::string& obj_path, size_t obj_line) {

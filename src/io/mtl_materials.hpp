@@ -34,10 +34,15 @@ class ObjMaterials {
   // a number tinyobj would overflow on is an error naming the MTL file and line.
   Status load_library(const std::string& name, const std::string& obj_path, size_t obj_line);
 
-  // The material's index, or -1 (the default material) for a name no library defined.
+  // The material's index, or -1 (the default material) for a name no library defined. A name of
+  // several words matches a newmtl line of the same words, however spaced (tinyobj keeps the whole
+  // rest of the line as the name: "Hard Shiny Plastic White"); failing that, as OBJ readers that
+  // take one word do, its first word.
   int id(const std::string& name) const {
-    auto it = ids_.find(name);
-    return it == ids_.end() ? -1 : it->second;
+    if (auto it = ids_.find(name); it != ids_.end()) return it->second;
+    if (auto it = spaced_ids_.find(words_of(name)); it != spaced_ids_.end()) return it->second;
+    size_t space = name.find(' ');
+    return space == name.npos ? -1 : id(name.substr(0, space));
   }
 
   // The materials with their maps (colour maps as sRGB textures, a grey bump map turned into a
@@ -58,7 +63,11 @@ class ObjMaterials {
   std::filesystem::path obj_dir_;
   int64_t max_bytes_;
   std::set<std::string> loaded_;
+  // A name's words, one space apart.
+  static std::string words_of(const std::string& name);
+
   std::map<std::string, int> ids_;
+  std::map<std::string, int> spaced_ids_;  // ids_ by words_of(name), the first material of each
   std::vector<tinyobj::material_t> all_;
   std::vector<std::filesystem::path> dirs_;
   std::vector<MtlGiven> given_;

@@ -88,8 +88,12 @@ class PieceParser {
     if (keyword.size() == 1 && keyword[0] == 'f') return face(words);
     if (keyword == "vt") return numbers(words, kObjUvs, 1);
     if (keyword == "vn") return numbers(words, kObjNormals, 3);
-    if (keyword == "usemtl") {
-      p_.events.push_back({false, p_.face_sizes.size(), line_, {std::string(words.next())}});
+    if (keyword == "usemtl") {  // the name's words, one space apart (a name may hold spaces)
+      std::string name(words.next());
+      for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
+        name.append(" ").append(w);
+      }
+      p_.events.push_back({false, p_.face_sizes.size(), line_, {std::move(name)}});
       return true;
     }
     if (keyword == "mtllib") {
