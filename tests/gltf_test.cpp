@@ -440,6 +440,30 @@ std::vector<BadCase> bad_cases() {
        },
        "mesh 0 primitive 0: accessor 0: sparse values: bytes 0 + 24 run past bufferView 5's 20 "
        "bytes"},
+      {"Gltf1", "v1.gltf",  // glTF 1.0's shape: asset version "1.0", meshes by name
+       [](GltfParts g, const std::string&) {
+         nlohmann::json j = nlohmann::json::parse(test::as_gltf(g));
+         j["asset"]["version"] = "1.0";
+         j["meshes"] = {{"box", j["meshes"][0]}};
+         return j.dump();
+       },
+       "a glTF 1.0 file (its meshes, nodes and materials are named objects, with shader "
+       "techniques); softrast reads glTF 2.0: convert it first"},
+      {"Gltf1WithoutAsset", "v1_no_asset.gltf",
+       [](GltfParts g, const std::string&) {
+         nlohmann::json j = nlohmann::json::parse(test::as_gltf(g));
+         j.erase("asset");
+         j["meshes"] = {{"box", j["meshes"][0]}};
+         return j.dump();
+       },
+       "a glTF 1.0 file"},
+      {"Glb1", "v1.glb",
+       [](GltfParts g, const std::string&) {
+         std::string glb = test::as_glb(g);
+         glb[4] = 1;  // the header's version
+         return glb;
+       },
+       "GLB version 1, a glTF 1.0 file; softrast reads glTF 2.0: convert it first"},
       {"TruncatedGlb", "cut.glb",
        [](GltfParts g, const std::string&) {
          std::string glb = test::as_glb(g);

@@ -67,6 +67,9 @@ Result<GlbChunks> read_glb_framing(const uint8_t* data, size_t size, const std::
   GlbChunks g;
   uint32_t version = le32(data + 4);
   g.length = le32(data + 8);
+  if (version == 1) {
+    return fail(name, "GLB version 1, a glTF 1.0 file; softrast reads glTF 2.0: convert it first");
+  }
   if (version != 2) return fail(name, "GLB version " + std::to_string(version) + " (expected 2)");
   if (g.length > size) {
     return fail(name, "truncated GLB: the header declares " + std::to_string(g.length) +
@@ -232,6 +235,22 @@ Status check_image_views(const json& root, const std::vector<uint64_t>& lengths)
   return {};
 }
 
+// glTF 1.0 (2015), which TinyGLTF does not read either: asset.version "1.0" (or the number 1),
+// or, where there is no asset (the version 1.0 schema did not require one), meshes held in an
+// object by name rather than in an array. Said as such instead of TinyGLTF's "asset not found"
+// or, for a document it half reads, "no triangles to draw".
+bool glTF_1(const json& root) {
+  auto asset = root.find("asset");
+  if (asset != root.end() && asset->is_object()) {
+    auto version = asset->find("version");
+    if (version == asset->end()) return false;
+    if (version->is_number()) return version->get<double>() < 2.0;
+    return version->is_string() && version->get<std::string>().rfind("1.", 0) == 0;
+  }
+  auto meshes = root.find("meshes");
+  return meshes != root.end() && meshes->is_object();
+}
+
 Status precheck(std::string_view text, const GlbChunks* glb, const std::string& base_dir) {
   json root;
   try {
@@ -245,6 +264,11 @@ Status precheck(std::string_view text, const GlbChunks* glb, const std::string& 
     return Status::error("invalid JSON: " + message);
   }
   if (!root.is_object()) return Status::error("the JSON is not an object");
+  if (glTF_1(root)) {
+    return Status::error(
+        "a glTF 1.0 file (its meshes, nodes and materials are named objects, "
+        "with shader techniques); softrast reads glTF 2.0: convert it first");
+  }
   if (auto req = root.find("extensionsRequired"); req != root.end() && req->is_array()) {
     for (const json& e : *req) {
       std::string ext = e.is_string() ? e.get<std::string>() : e.dump();
