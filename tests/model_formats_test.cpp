@@ -320,6 +320,22 @@ TEST_F(ModelFormatsTest, MessagesNameTheFileAndPlace) {
                ":6: expected 'vertex', found 'endloop'");
 }
 
+// A header line that is no PLY statement (Blender 2.4x's "Created by ..." without 'comment', as in
+// assimp's Wuson.ply) is read past with a warning naming it, and the model loads.
+TEST_F(ModelFormatsTest, PlyHeaderLineThatIsNoStatementIsAWarning) {
+  std::string p = write("blender.ply",
+                        "ply\nformat ascii 1.0\nCreated by Blender3D 247 - www.blender.org\n"
+                        "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                        "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                        "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  Result<Mesh> mesh = load_model(p);
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  EXPECT_EQ(mesh->triangle_count(), 1u);
+  ASSERT_EQ(mesh->warnings.size(), 1u);
+  EXPECT_EQ(mesh->warnings[0], p + ":3: header line 'Created by Blender3D 247 - www.blender.org' "
+                                   "is not a PLY statement; read past as a comment");
+}
+
 TEST_F(ModelFormatsTest, FilesThatAreNotModelsSayWhatTheyAre) {
   Image pixel(1, 1);
   ASSERT_TRUE(save_image((dir_ / "tex.png").string(), pixel).ok());

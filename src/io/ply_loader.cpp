@@ -190,8 +190,9 @@ Role vertex_role(std::string_view name) {
 struct Header {
   Encoding encoding = Encoding::kAscii;
   std::vector<Element> elements;
-  size_t data_start = 0;  // byte offset of the first element
-  size_t lines = 0;       // header lines (ASCII data starts on line lines + 1)
+  size_t data_start = 0;              // byte offset of the first element
+  size_t lines = 0;                   // header lines (ASCII data starts on line lines + 1)
+  std::vector<std::string> warnings;  // lines read past
 };
 
 class HeaderParser {
@@ -312,7 +313,13 @@ Status HeaderParser::parse(Header& h) {
     } else if (w[0] == "property") {
       s = property_line(w, h);
     } else {
-      s = error("unknown header line '" + std::string(w[0]) + "'");
+      // Not a PLY statement: read past, as a comment, with a warning. Blender 2.4x wrote its
+      // "Created by Blender3D ..." line without the 'comment' keyword (assimp's Wuson.ply), and
+      // the lines that matter (format, element, property) are checked as they come.
+      std::string excerpt(text.substr(0, 60));
+      h.warnings.push_back(name_ + ":" + std::to_string(line_) + ": header line '" + excerpt +
+                           (text.size() > 60 ? "...'" : "'") +
+                           " is not a PLY statement; read past as a comment");
     }
     if (!s.ok()) return s;
   }
@@ -687,7 +694,10 @@ Result<Mesh> parse_ply(const char* data, size_t size, const std::string& name) {
   Header header;
   if (Status s = HeaderParser(data, size, name).parse(header); !s.ok()) return s;
   BodyReader body(data, size, header, name);
-  return PlyBuilder(header, name, body).build();
+  Result<Mesh> mesh = PlyBuilder(header, name, body).build();
+  if (mesh)
+    mesh->warnings.insert(mesh->warnings.begin(), header.warnings.begin(), header.warnings.end());
+  return mesh;
 }
 
 }  // namespace softrast::detail
