@@ -6,6 +6,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -16,6 +18,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include <glm/geometric.hpp>
 
 #include "softrast/framebuffer.hpp"
 #include "softrast/image.hpp"
@@ -150,14 +154,17 @@ std::string stl_ascii() {
   return s + "endsolid\n";
 }
 
-std::string stl_binary() {
+// With `clockwise`, each facet's corners run clockwise about its (outward) normal.
+std::string stl_binary(bool clockwise = false) {
   std::string s(80, ' ');
   std::memcpy(s.data(), "binary STL written by softrast's tests", 38);
   put(s, uint32_t(12), false);
   for (const Quad& q : box()) {
     for (int t = 0; t < 2; ++t) {
       for (int c = 0; c < 3; ++c) put(s, q.n[c], false);
-      for (int k : {0, t + 1, t + 2}) {
+      const std::array<int, 3> order =
+          clockwise ? std::array<int, 3>{0, t + 2, t + 1} : std::array<int, 3>{0, t + 1, t + 2};
+      for (int k : order) {
         for (int c = 0; c < 3; ++c) put(s, q.p[k][c], false);
       }
       put(s, uint16_t(0), false);
@@ -334,6 +341,33 @@ TEST_F(ModelFormatsTest, PlyHeaderLineThatIsNoStatementIsAWarning) {
   ASSERT_EQ(mesh->warnings.size(), 1u);
   EXPECT_EQ(mesh->warnings[0], p + ":3: header line 'Created by Blender3D 247 - www.blender.org' "
                                    "is not a PLY statement; read past as a comment");
+}
+
+// An STL whose corners run clockwise about its normals throughout (assimp's Spider_binary.stl)
+// loads with its winding turned to agree with them, so that the outside is the front (lit under
+// two-sided lighting, kept by --cull back), and one warning; the same box wound by the rule has no
+// warning and the same corners in each triangle.
+TEST_F(ModelFormatsTest, StlWoundAgainstItsNormalsIsTurned) {
+  Result<Mesh> turned = load_model(write("clockwise.stl", stl_binary(true)));
+  Result<Mesh> plain = load_model(write("plain.stl", stl_binary()));
+  ASSERT_TRUE(turned.ok()) << turned.status().message();
+  ASSERT_TRUE(plain.ok()) << plain.status().message();
+  EXPECT_TRUE(plain->warnings.empty());
+  ASSERT_EQ(turned->warnings.size(), 1u);
+  EXPECT_NE(turned->warnings[0].find("12 of 12 facets list their corners clockwise"),
+            std::string::npos)
+      << turned->warnings[0];
+  ASSERT_EQ(turned->indices.size(), 36u);
+  for (size_t t = 0; t < 36; t += 3) {
+    const glm::vec3 a = turned->positions[turned->indices[t]],
+                    b = turned->positions[turned->indices[t + 1]],
+                    c = turned->positions[turned->indices[t + 2]];
+    EXPECT_GT(glm::dot(glm::cross(b - a, c - a), turned->normals[turned->indices[t]]), 0.0f)
+        << "triangle " << t / 3;
+    std::vector<glm::vec3> mine = {a, b, c}, theirs;
+    for (int k = 0; k < 3; ++k) theirs.push_back(plain->positions[plain->indices[t + size_t(k)]]);
+    EXPECT_TRUE(std::is_permutation(mine.begin(), mine.end(), theirs.begin()));
+  }
 }
 
 TEST_F(ModelFormatsTest, FilesThatAreNotModelsSayWhatTheyAre) {

@@ -6,13 +6,15 @@
 // then `facet normal nx ny nz / outer loop / vertex x y z` (three) `/ endloop / endfacet`, then
 // `endsolid NAME` (several solids may follow one another; keywords in any case). Each triangle gets
 // three vertices of its own whose normal is the facet normal; a zero or non-finite facet normal
-// (common in exported files) is replaced by the triangle's own, counter-clockwise.
+// (common in exported files) is replaced by the triangle's own, counter-clockwise. A file whose
+// corners run clockwise about its normals throughout is turned (match_winding_to_normals).
 
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include <charconv>
 #include <system_error>
@@ -245,6 +247,42 @@ Result<Mesh> AsciiStl::parse() {
   return std::move(mesh_);
 }
 
+// STL says each facet's normal points out of the solid and its corners run counter-clockwise seen
+// from outside. Files that keep the normals but list every corner the other way round (assimp's
+// Spider_binary.stl: all 1368 facets) drew dark: the faces the camera sees are back faces by
+// their winding, and two-sided lighting turned their normals away. Where most facets whose normal
+// was given disagree with their winding, the file's winding is taken to be the reversed one and
+// every triangle is turned (a few facets with stray normals are left as they are, and a file of
+// zero normals has nothing to compare).
+void match_winding_to_normals(Mesh& mesh, const std::string& name) {
+  size_t against = 0, with = 0;
+  for (size_t t = 0; t < mesh.indices.size(); t += 3) {
+    const glm::vec3* p = &mesh.positions[mesh.indices[t]];  // three vertices of its own
+    float side = glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), mesh.normals[mesh.indices[t]]);
+    against += side < 0.0f;
+    with += side > 0.0f;
+  }
+  if (against <= with) return;
+  for (size_t t = 0; t < mesh.indices.size(); t += 3) {
+    std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+  }
+  mesh.warnings.push_back(name + ": " + std::to_string(against) + " of " +
+                          std::to_string(mesh.indices.size() / 3) +
+                          " facets list their corners clockwise about their normals; every "
+                          "facet's corners are taken in the reverse order");
+}
+
+Result<Mesh> parse(const char* data, size_t size, bool binary, const std::string& name) {
+  if (binary) return parse_binary(data, size, name);
+  Result<Mesh> mesh = AsciiStl(data, size, name).parse();
+  if (!mesh.ok() && size >= 84 && 84 + 50 * uint64_t(little32(data + 80)) < size) {
+    // A binary file whose header begins with "solid" (some writers put it there) and that has
+    // bytes after its triangles, so that its size did not tell: binary after all if it reads so.
+    if (Result<Mesh> as_binary = parse_binary(data, size, name); as_binary.ok()) return as_binary;
+  }
+  return mesh;
+}
+
 }  // namespace
 
 bool is_binary_stl(const char* data, size_t size) {
@@ -253,13 +291,8 @@ bool is_binary_stl(const char* data, size_t size) {
 
 Result<Mesh> parse_stl(const char* data, size_t size, bool binary, const std::string& name) {
   if (size == 0) data = "";  // an empty vector's data() may be null, which memchr must not get
-  if (binary) return parse_binary(data, size, name);
-  Result<Mesh> mesh = AsciiStl(data, size, name).parse();
-  if (!mesh.ok() && size >= 84 && 84 + 50 * uint64_t(little32(data + 80)) < size) {
-    // A binary file whose header begins with "solid" (some writers put it there) and that has
-    // bytes after its triangles, so that its size did not tell: binary after all if it reads so.
-    if (Result<Mesh> as_binary = parse_binary(data, size, name); as_binary.ok()) return as_binary;
-  }
+  Result<Mesh> mesh = parse(data, size, binary, name);
+  if (mesh) match_winding_to_normals(*mesh, name);
   return mesh;
 }
 
