@@ -137,6 +137,28 @@ TEST(Materials, NamesWithSpacesAreFound) {
   EXPECT_EQ(mesh->materials[size_t(mesh->submeshes[1].material)].diffuse, glm::vec3(1, 0, 0));
 }
 
+// illum 0 and 1 have no specular term, and Ns 0 means no highlight (3ds Max's Max2Mtl writes Ks 0.9
+// with Ns 0 for a material without one; Blinn-Phong would light the whole side white): their Ks
+// becomes 0. illum 2 with an exponent keeps its Ks, and a material that gives neither keeps the
+// default.
+TEST(Materials, IllumAndZeroShininessTurnTheHighlightOff) {
+  Folder f;
+  f.write("a.obj", std::string("mtllib a.mtl\n") + kQuadObj + "usemtl flat\nf 1/1/1 2/2/1 3/3/1\n");
+  f.write("a.mtl",
+          "newmtl flat\nKs 0.9 0.9 0.9\nillum 1\n"
+          "newmtl dull\nKs 0.9 0.9 0.9\nNs 0.0\nillum 2\n"
+          "newmtl shiny\nKs 0.9 0.9 0.9\nNs 10\nillum 2\n"
+          "newmtl plain\nKd 1 1 1\n");
+  Result<Mesh> mesh = load_obj(f.path("a.obj"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  ASSERT_EQ(mesh->materials.size(), 4u);
+  EXPECT_EQ(mesh->materials[0].specular, glm::vec3(0.0f));
+  EXPECT_EQ(mesh->materials[1].specular, glm::vec3(0.0f));
+  EXPECT_EQ(mesh->materials[2].specular, glm::vec3(0.9f));
+  EXPECT_EQ(mesh->materials[2].shininess, 10.0f);
+  EXPECT_EQ(mesh->materials[3].specular, glm::vec3(0.4f));
+}
+
 TEST(Materials, BadMtlValuesAreErrorsAndMissingMapsWarnings) {
   Folder f;
   f.write("a.obj", std::string("mtllib a.mtl\n") + kQuadObj + "usemtl m\nf 1/1/1 2/2/1 3/3/1\n");

@@ -107,8 +107,8 @@ std::string complete_map_options(std::string_view line) {
 }
 
 // For each material that tinyobj::LoadMtl will produce from `text`, in its order, which of Kd,
-// Ks and Ns the MTL gave it (tinyobj cannot tell a missing one from its zero default). Mirrors
-// LoadMtl: one material per `newmtl` line (names are never empty after its trimming), or a
+// Ks, Ns and illum the MTL gave it (tinyobj cannot tell a missing one from its zero default).
+// Mirrors LoadMtl: one material per `newmtl` line (names are never empty after its trimming), or a
 // single unnamed one if there is no `newmtl` at all.
 std::vector<MtlGiven> scan_given(const std::string& text) {
   std::vector<MtlGiven> given;
@@ -126,6 +126,7 @@ std::vector<MtlGiven> scan_given(const std::string& text) {
     g.kd = g.kd || is_key(token, "Kd");
     g.ks = g.ks || is_key(token, "Ks");
     g.ns = g.ns || is_key(token, "Ns");
+    g.illum = g.illum || is_key(token, "illum");
   }
   if (given.empty()) given.push_back(unnamed);
   return given;
@@ -355,6 +356,14 @@ Result<std::vector<Material>> ObjMaterials::convert(const std::string& path,
       return fail(path, "Ns of " + named + " is " + std::to_string(m.shininess) +
                             "; it must be in [0, 1000]");
     }
+    // No highlight where the MTL turns it off: illum 0 and 1 (colour, or colour and ambient, in
+    // the MTL's list of illumination models: no specular term), and Ns 0, which Blinn-Phong would
+    // make a highlight of Ks over the whole lit side. That is what 3ds Max's Max2Mtl writes for a
+    // material without a highlight (Ks 0.9 and Ns 0: assimp's regr01.obj drew white), and what
+    // assimp takes shininess 0 to mean.
+    const bool no_highlight = (given_[i].illum && (source.illum == 0 || source.illum == 1)) ||
+                              (given_[i].ns && source.shininess == 0.0f);
+    if (no_highlight) m.specular = glm::vec3(0.0f);
     if (!(m.opacity >= 0.0f && m.opacity <= 1.0f)) {
       return fail(path, "d (or Tr) of " + named + " is " + std::to_string(m.opacity) +
                             "; it must be in [0, 1]");

@@ -18,7 +18,7 @@ namespace softrast::detail {
 
 // Which of the statements tinyobj cannot tell from their zero defaults a material had.
 struct MtlGiven {
-  bool kd = false, ks = false, ns = false;
+  bool kd = false, ks = false, ns = false, illum = false;
 };
 
 // The materials of every MTL library the OBJ names, relative to the OBJ's folder, each with its
