@@ -388,6 +388,23 @@ TEST_F(ModelFormatsTest, FilesThatAreNotModelsSayWhatTheyAre) {
     EXPECT_EQ(mesh.status().message(),
               path + ": this is " + what + ", not a model (softrast reads OBJ, PLY, STL and glTF)");
   }
+  // Models in other 3D formats, told by their extension (read as OBJ, they failed with "no faces"
+  // or "NUL byte: not a text file").
+  write("duck.dae", "<?xml version=\"1.0\"?>\n<COLLADA version=\"1.4.1\">\n</COLLADA>\n");
+  write("car.3ds", std::string("\x4d\x4d\x10\x00\x00\x00", 6) + std::string(32, '\0'));
+  const std::pair<const char*, const char*> others[] = {
+      {"duck.dae", "a COLLADA scene (.dae)"},
+      {"car.3ds", "a 3D Studio scene (.3ds)"},
+  };
+  for (auto [name, what] : others) {
+    std::string path = (dir_ / name).string();
+    Result<Mesh> mesh = load_model(path);
+    ASSERT_FALSE(mesh.ok()) << name;
+    EXPECT_EQ(mesh.status().message(),
+              path + ": this is " + what +
+                  ", a format softrast does not read (it reads OBJ, PLY, STL and glTF 2.0): "
+                  "export the model as one of those");
+  }
 }
 
 }  // namespace

@@ -83,6 +83,59 @@ const char* not_a_model(std::string_view head) {
   return nullptr;
 }
 
+// Other 3D formats, by their usual extension: a file of one of them (read as OBJ, the fallback)
+// failed with "no faces" or "NUL byte: not a text file", which did not say what was wrong.
+struct OtherFormat {
+  std::string_view extension;
+  const char* what;
+};
+constexpr std::array<OtherFormat, 37> kOtherFormats = {{
+    {".dae", "a COLLADA scene"},
+    {".fbx", "an FBX scene"},
+    {".3ds", "a 3D Studio scene"},
+    {".max", "a 3ds Max scene"},
+    {".blend", "a Blender scene"},
+    {".ma", "a Maya scene"},
+    {".mb", "a Maya scene"},
+    {".c4d", "a Cinema 4D scene"},
+    {".lwo", "a LightWave object"},
+    {".lws", "a LightWave scene"},
+    {".lxo", "a modo scene"},
+    {".x", "a DirectX model"},
+    {".ase", "a 3ds Max ASCII scene"},
+    {".ac", "an AC3D model"},
+    {".ms3d", "a MilkShape model"},
+    {".md2", "a Quake II model"},
+    {".md3", "a Quake III model"},
+    {".md5mesh", "a Doom 3 model"},
+    {".mdl", "a Quake or Half-Life model"},
+    {".off", "an OFF mesh"},
+    {".3mf", "a 3MF package"},
+    {".amf", "an AMF model"},
+    {".usd", "a USD scene"},
+    {".usda", "a USD scene"},
+    {".usdc", "a USD scene"},
+    {".usdz", "a USD package"},
+    {".x3d", "an X3D scene"},
+    {".wrl", "a VRML scene"},
+    {".ifc", "an IFC building model"},
+    {".dxf", "a DXF drawing"},
+    {".step", "a STEP CAD model"},
+    {".stp", "a STEP CAD model"},
+    {".iges", "an IGES CAD model"},
+    {".igs", "an IGES CAD model"},
+    {".skp", "a SketchUp model"},
+    {".abc", "an Alembic cache"},
+    {".bvh", "a motion capture (BVH) file"},
+}};
+
+const char* other_format(const std::string& extension) {
+  for (const OtherFormat& f : kOtherFormats) {
+    if (f.extension == extension) return f.what;
+  }
+  return nullptr;
+}
+
 enum class Kind { kObj, kPly, kBinaryStl, kAsciiStl };
 
 bool starts_solid(std::string_view head) {
@@ -187,6 +240,11 @@ Result<Mesh> load_model(const std::string& path) {
   if (const char* what = not_a_model(head)) {
     return fail(path, std::string("this is ") + what +
                           ", not a model (softrast reads OBJ, PLY, STL and glTF)");
+  }
+  if (const char* what = other_format(ext)) {
+    return fail(path, std::string("this is ") + what + " (" + ext +
+                          "), a format softrast does not read (it reads OBJ, PLY, STL and glTF "
+                          "2.0): export the model as one of those");
   }
   if (ext == ".stl") return load_stl(path);  // says why it is not one
   if (ext == ".ply") return load_ply(path);
