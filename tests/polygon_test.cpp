@@ -174,6 +174,25 @@ TEST(Polygon, DegenerateAndSelfCrossingPolygonsStillGiveNMinusTwoTriangles) {
   }
 }
 
+// A file's allowance of point tests: each concave face takes from it, and once it is spent the
+// faces are fanned (bounded time for a file of many large concave faces).
+TEST(Polygon, AFilesAllowanceIsSharedAndThenFacesAreFanned) {
+  std::vector<glm::vec3> points;
+  for (P2 p : u_shape()) points.push_back(glm::vec3(float(p.x), float(p.y), 0.0f));
+  std::vector<uint32_t> fan;
+  for (uint32_t k = 2; k < points.size(); ++k) fan.insert(fan.end(), {0, k - 1, k});
+  uint64_t budget = 1000;
+  std::vector<uint32_t> tri;
+  detail::triangulate_polygon(points.data(), points.size(), tri, &budget);
+  EXPECT_NE(tri, fan);
+  EXPECT_LT(budget, 1000u);
+  EXPECT_GT(budget, 0u);
+  budget = 0;
+  tri.clear();
+  detail::triangulate_polygon(points.data(), points.size(), tri, &budget);
+  EXPECT_EQ(tri, fan);
+}
+
 class PolygonFileTest : public ::testing::Test {
  protected:
   void SetUp() override {

@@ -1,6 +1,7 @@
 // geometry/polygon.cpp: polygon faces into triangles (fan when convex, else ear clipping).
 #include "geometry/polygon.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace softrast::detail {
@@ -63,14 +64,13 @@ void append_fan(size_t n, std::vector<uint32_t>& out) {
 // at the same position as the triangle's own corners aside) is cut off. Stops at three corners,
 // after a whole round without an ear, or when the budget of point tests is spent; the ring left
 // is fanned.
-void clip_ears(const std::vector<Point2>& p, std::vector<uint32_t>& out) {
+void clip_ears(const std::vector<Point2>& p, std::vector<uint32_t>& out, uint64_t& budget) {
   const size_t n = p.size();
   std::vector<uint32_t> prev(n), next(n);
   for (size_t i = 0; i < n; ++i) {
     prev[i] = uint32_t(i == 0 ? n - 1 : i - 1);
     next[i] = uint32_t(i + 1 == n ? 0 : i + 1);
   }
-  size_t budget = kEarTests * n * n;
   auto is_ear = [&](uint32_t a, uint32_t v, uint32_t c) {
     if (turn(p[a], p[v], p[c]) <= 0.0) return false;
     for (uint32_t r = next[c]; r != a; r = next[r]) {
@@ -102,10 +102,15 @@ void clip_ears(const std::vector<Point2>& p, std::vector<uint32_t>& out) {
 
 }  // namespace
 
-void triangulate_polygon(const glm::vec3* points, size_t n, std::vector<uint32_t>& out) {
+void triangulate_polygon(const glm::vec3* points, size_t n, std::vector<uint32_t>& out,
+                         uint64_t* budget) {
   std::vector<Point2> projected;
-  if (n > 3 && n <= kMaxEarCorners && project(points, n, projected) && !convex(projected)) {
-    clip_ears(projected, out);
+  const uint64_t allowed = std::min<uint64_t>(kEarTests * n * n, budget ? *budget : UINT64_MAX);
+  if (n > 3 && n <= kMaxEarCorners && allowed > 0 && project(points, n, projected) &&
+      !convex(projected)) {
+    uint64_t left = allowed;
+    clip_ears(projected, out, left);
+    if (budget) *budget -= allowed - left;
     return;
   }
   append_fan(n, out);

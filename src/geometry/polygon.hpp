@@ -20,13 +20,17 @@ namespace softrast::detail {
 // polygon (a fan would fill a ring's hole or an L's notch): corners at one position, such as the
 // two ends of the cut that joins a hole to its outline, are not taken as lying inside an ear.
 //
-// The ears are searched at most kEarTests point tests per squared corner count, and polygons of
-// more than kMaxEarCorners corners are fanned: the cost stays a bounded multiple of the face's
-// size whatever the file holds (a self-intersecting polygon has no ears to find; its remainder is
-// fanned).
-void triangulate_polygon(const glm::vec3* points, size_t n, std::vector<uint32_t>& out);
+// The ears are searched with at most kEarTests point tests per squared corner count, and
+// polygons of more than kMaxEarCorners corners are fanned (a self-intersecting polygon has no
+// ears to find; its remainder is fanned). `budget`, when given, is a file's allowance of point
+// tests, shared by its faces and reduced by each: once it is spent, faces are fanned, so that a
+// file of many large concave faces costs a bounded time (kFileEarTests, about a second), not a
+// time that grows with the square of its faces' size.
+void triangulate_polygon(const glm::vec3* points, size_t n, std::vector<uint32_t>& out,
+                         uint64_t* budget = nullptr);
 
 inline constexpr size_t kMaxEarCorners = 256;
 inline constexpr size_t kEarTests = 4;
+inline constexpr uint64_t kFileEarTests = uint64_t(1) << 28;
 
 }  // namespace softrast::detail

@@ -252,6 +252,7 @@ class ObjMerge {
   // add_polygon's scratch: a face's vertices, positions and triangles (as corner numbers).
   std::vector<uint32_t> polygon_vertices_, polygon_triangles_;
   std::vector<glm::vec3> polygon_points_;
+  uint64_t ear_tests_ = detail::kFileEarTests;  // the file's allowance (geometry/polygon.hpp)
   size_t pieces_ = 0;
 };
 
@@ -298,7 +299,7 @@ void ObjMerge::add_polygon(const ObjCorner* c, size_t n, const KeyOf& key_of,
   }
   polygon_triangles_.clear();
   if (positioned) {
-    detail::triangulate_polygon(polygon_points_.data(), n, polygon_triangles_);
+    detail::triangulate_polygon(polygon_points_.data(), n, polygon_triangles_, &ear_tests_);
   } else {
     for (uint32_t k = 2; k < n; ++k)
       polygon_triangles_.insert(polygon_triangles_.end(), {0, k - 1, k});

@@ -531,8 +531,9 @@ class PlyBuilder {
   uint64_t vertex_count_ = 0;
   bool has_normals_ = false, has_uvs_ = false, has_colors_ = false;
   std::vector<uint32_t> corners_;
-  std::vector<glm::vec3> points_;    // the face's corners' positions
-  std::vector<uint32_t> triangles_;  // its triangles, as corner numbers
+  std::vector<glm::vec3> points_;               // the face's corners' positions
+  std::vector<uint32_t> triangles_;             // its triangles, as corner numbers
+  uint64_t ear_tests_ = detail::kFileEarTests;  // the file's allowance (geometry/polygon.hpp)
 };
 
 bool PlyBuilder::read_vertex(const Element& e, size_t index) {
@@ -611,7 +612,7 @@ bool PlyBuilder::read_face(const Element& e, const Property& indices, size_t fac
     points_.clear();
     for (uint32_t corner : corners_) points_.push_back(mesh_.positions[corner]);
     triangles_.clear();
-    detail::triangulate_polygon(points_.data(), points_.size(), triangles_);
+    detail::triangulate_polygon(points_.data(), points_.size(), triangles_, &ear_tests_);
     for (uint32_t k : triangles_) mesh_.indices.push_back(corners_[k]);
   }
   return true;
