@@ -294,6 +294,33 @@ TEST(CliFraming, ModelFlatAcrossTheViewIsSeenFaceOn) {
   EXPECT_LE(edge.right - edge.left, 2) << "--view front is still the front";
 }
 
+// The demo scene is drawn mipmapped unless --filter says otherwise (its floor reaches the horizon,
+// where bilinear filtering draws moire); a model keeps bilinear, SCENES.md's filter.
+TEST(CliFilter, DemoSceneDefaultsToTrilinearAndModelsToBilinear) {
+  CliFolder folder;
+  Image plain = folder.render("--size 160x120", "demo.png");
+  Image trilinear = folder.render("--size 160x120 --filter trilinear", "tri.png");
+  Image bilinear = folder.render("--size 160x120 --filter bilinear", "bi.png");
+  EXPECT_EQ(plain.rgba, trilinear.rgba);
+  EXPECT_NE(plain.rgba, bilinear.rgba);
+  folder.write("quad.obj", kQuadObj);
+  Image stripes(64, 64);
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      uint8_t v = x % 2 ? 255 : 0;
+      uint8_t* p = stripes.pixel(x, y);
+      p[0] = p[1] = p[2] = v, p[3] = 255;
+    }
+  }
+  ASSERT_TRUE(save_image(folder.path("stripes.png"), stripes).ok());
+  // Minified 64 texels to ~20 pixels: bilinear and trilinear differ, and the default is bilinear.
+  const std::string model = "quad.obj --shader texture --texture stripes.png --size 24x24";
+  EXPECT_EQ(folder.render(model, "m.png").rgba,
+            folder.render(model + " --filter bilinear", "mb.png").rgba);
+  EXPECT_NE(folder.render(model, "m2.png").rgba,
+            folder.render(model + " --filter trilinear", "mt.png").rgba);
+}
+
 TEST(CliFraming, AnglesUpAxesAndZoom) {
   CliFolder folder;
   folder.write("part.obj", long_part_obj());

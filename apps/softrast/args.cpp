@@ -123,7 +123,8 @@ void define_shading_flags(CLI::App& app, RawArgs& a) {
          "--filter", a.filter,
          "Texture filter: nearest, bilinear or trilinear (mipmapped: bilinear in the two mip "
          "levels nearest the level of detail, blended; no shimmer where the texture is "
-         "minified) (default bilinear)")
+         "minified) (default bilinear, as SCENES.md's pipeline has it; trilinear for the "
+         "demo scene, whose floor reaches the horizon)")
       ->type_name("MODE");
   app.add_flag("--shadows", a.shadows,
                "Shadows of the directional light for phong: a depth map from the light over the "

@@ -39,9 +39,9 @@ struct RawArgs {
   std::string raster = "edge";
   int threads = 0;
   bool reference_path = false;
-  int msaa = 1;          // samples per pixel (RenderState::samples)
-  bool shadows = false;  // shadow map of the light (RenderOptions::shadows)
-  std::string filter = "bilinear";
+  int msaa = 1;                       // samples per pixel (RenderState::samples)
+  bool shadows = false;               // shadow map of the light (RenderOptions::shadows)
+  std::optional<std::string> filter;  // default: bilinear, trilinear for the demo scene
   std::string wrap = "repeat";
   std::optional<int> frames;
   bool quiet = false;

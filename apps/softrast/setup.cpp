@@ -175,7 +175,10 @@ void interpret_shading(const RawArgs& a, RenderOptions& options, FirstError& e) 
   e.fail_if(!in_unit_range(a.alpha), "--alpha: must be in [0, 1]");
   options.alpha = a.alpha;
   options.shadows = a.shadows;
-  e.take(lookup<Filter>("--filter", kFilters, a.filter), options.sampler.filter);
+  // The demo scene's floor reaches the horizon, where bilinear filtering draws moire: without
+  // --filter it is drawn mipmapped. Models keep bilinear, the benchmark pipeline's (SCENES.md).
+  const std::string filter = a.filter.value_or(a.models.empty() ? "trilinear" : "bilinear");
+  e.take(lookup<Filter>("--filter", kFilters, filter), options.sampler.filter);
   e.take(lookup<Wrap>("--wrap", kWraps, a.wrap), options.sampler.wrap_u);
   e.take(debug_view_named("--debug", a.debug), options.debug_view);
   options.sampler.wrap_v = options.sampler.wrap_u;
