@@ -322,7 +322,8 @@ void define_info_flags(CLI::App& app, InfoArgs& a) {
                "loaded materials (name, diffuse, pbr); or error");
   app.footer(
       "Vertices are the mesh's (one per distinct position/normal/uv corner), triangles after "
-      "fan triangulation. Files a model names are looked up as the loader does (MTL libraries "
+      "triangulation (a convex polygon fanned, a concave one cut into ears). Files a model names "
+      "are looked up as the loader does (MTL libraries "
       "beside the OBJ, maps beside their MTL) and marked found or MISSING. A material whose "
       "maps have -s, -o or -clamp options says where its maps are placed.\n\n"
       "Examples:\n"

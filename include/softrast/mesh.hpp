@@ -91,17 +91,17 @@ inline constexpr int64_t kMaxObjFileBytes = int64_t(2) << 30;
 // Largest MTL file load_obj reads: 64 MiB, far beyond any real material library.
 inline constexpr int64_t kMaxMtlFileBytes = int64_t(64) << 20;
 
-// Loads a Wavefront OBJ (polygons fan-triangulated) with its MTL libraries (Kd, Ks, Ns, d or Tr,
-// map_Kd, map_Ks, map_d, and norm, map_Bump or bump with -bm as tangent-space normal maps; a
-// greyscale bump map is a height map, turned into a normal map); v, vt, vn, f, usemtl and
-// mtllib are read, other statements skipped. Texture paths are relative to the MTL file, MTL
-// paths to the OBJ, and found as find_referenced_file finds them (Windows separators, case). An OBJ
-// with no materials at all takes the maps of the tutorial models' convention beside it, when they
-// exist: <model>_diffuse.tga, <model>_spec.tga, and <model>_nm_tangent.tga (tangent space) or else
-// <model>_nm.tga (object space), as one material named after the model. A material with a
-// tangent-space normal map gets Mesh::tangents. A missing MTL leaves its materials undefined (their
-// faces get the default material) and a missing or unreadable map_Kd leaves its material
-// untextured; both add a line to Mesh::warnings:
+// Loads a Wavefront OBJ (convex polygons fanned, concave ones cut by ear clipping) with its MTL
+// libraries (Kd, Ks, Ns, d or Tr, illum, map_Kd, map_Ks, map_d, and norm, map_Bump or bump with
+// -bm as tangent-space normal maps; a greyscale bump map is a height map, turned into a normal
+// map); v, vt, vn, f, usemtl and mtllib are read, other statements skipped. Texture paths are
+// relative to the MTL file, MTL paths to the OBJ, and found as find_referenced_file finds them
+// (Windows separators, case). An OBJ with no materials at all takes the maps of the tutorial
+// models' convention beside it, when they exist: <model>_diffuse.tga, <model>_spec.tga, and
+// <model>_nm_tangent.tga (tangent space) or else <model>_nm.tga (object space), as one material
+// named after the model. A material with a tangent-space normal map gets Mesh::tangents. A missing
+// MTL leaves its materials undefined (their faces get the default material) and a missing or
+// unreadable map_Kd leaves its material untextured; both add a line to Mesh::warnings:
 //   "model.obj:1: material library 'model.mtl' not found; its materials get the default colour"
 //   "model.obj: material 'skin': map_Kd: skin.png: cannot open: No such file or directory; drawn
 //    without this texture"  (the second part is load_image's message)
@@ -124,11 +124,11 @@ std::optional<std::string> find_referenced_file(const std::string& folder, const
 // present nx, ny, nz and u, v (or s, t, texture_u, texture_v, texture_s, texture_t), and red,
 // green, blue (alpha) as Mesh::colors (integers over their type's largest value, 255 for uchar;
 // floats as they are; clamped to [0, 1]); other properties are read and dropped. Faces are the face
-// element's vertex_indices (or vertex_index) list of any integer types, fan-triangulated. Without
-// normals, smooth normals are computed. Errors name the file and the line (ASCII) or the element
-// and byte (binary): a bad header, counts that need more bytes than the file has (checked before
-// allocating), lists over 65536 items, a number that does not fit its type, a vertex index out of
-// range, no faces.
+// element's vertex_indices (or vertex_index) list of any integer types (a convex face fanned, a
+// concave one cut by ear clipping). Without normals, smooth normals are computed. Errors name the
+// file and the line (ASCII) or the element and byte (binary): a bad header, counts that need more
+// bytes than the file has (checked before allocating), lists over 65536 items, a number that does
+// not fit its type, a vertex index out of range, no faces.
 Result<Mesh> load_ply(const std::string& path);
 
 // Loads an STL file, binary (84 + 50 * count bytes; bytes after the triangles are a warning) or
