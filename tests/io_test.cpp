@@ -21,8 +21,10 @@
 #include <glm/geometric.hpp>
 
 #include "io/obj_loader.hpp"
+#include "softrast/framebuffer.hpp"
 #include "softrast/image.hpp"
 #include "softrast/mesh.hpp"
+#include "softrast/renderer.hpp"
 #include "softrast/texture.hpp"
 
 namespace softrast {
@@ -541,6 +543,64 @@ TEST_F(IoTest, ComputeSmoothNormalsGroupsEqualPositions) {
   EXPECT_EQ(mesh.normals[6], glm::vec3(0, 0, 1));  // in no triangle
 }
 
+// l (a polyline: each corner to the next) and p elements: indices into the faces' vertices, in
+// runs of the material in use; render_mesh draws them one pixel wide, unlit, in its colour.
+TEST_F(IoTest, ObjLinesAndPointsAreReadAndDrawn) {
+  write("lp.mtl", "newmtl red\nKd 1 0 0\nnewmtl green\nKd 0 1 0\n");
+  write("lp.obj", std::string("mtllib lp.mtl\n") + kQuadPositions +
+                      "f 1 2 3\nusemtl red\nl 1 2 3 4\nusemtl green\np 4 3\nl -1 -3\n");
+  Result<Mesh> mesh = load_obj(path("lp.obj"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  EXPECT_EQ(mesh->triangle_count(), 1u);
+  EXPECT_EQ(mesh->vertex_count(), 4u);  // the face's three, then position 4
+  EXPECT_EQ(mesh->line_indices, (std::vector<uint32_t>{0, 1, 1, 2, 2, 3, 3, 1}));
+  EXPECT_EQ(mesh->point_indices, (std::vector<uint32_t>{3, 2}));
+  ASSERT_EQ(mesh->materials.size(), 2u);
+  ASSERT_EQ(mesh->line_submeshes.size(), 2u);
+  EXPECT_EQ(mesh->line_submeshes[0].material, 0);
+  EXPECT_EQ(mesh->line_submeshes[0].first_index, 0u);
+  EXPECT_EQ(mesh->line_submeshes[0].index_count, 6u);
+  EXPECT_EQ(mesh->line_submeshes[1].material, 1);
+  EXPECT_EQ(mesh->line_submeshes[1].first_index, 6u);
+  EXPECT_EQ(mesh->line_submeshes[1].index_count, 2u);
+  ASSERT_EQ(mesh->point_submeshes.size(), 1u);
+  EXPECT_EQ(mesh->point_submeshes[0].material, 1);
+
+  // Drawn: a red line across the middle of the image and a green point above it, nothing else.
+  write("draw.mtl", "newmtl red\nKd 1 0 0\nnewmtl green\nKd 0 1 0\n");
+  write("draw.obj",
+        "mtllib draw.mtl\nv -1 0 0\nv 1 0 0\nv 0 0.5 0\nusemtl red\nl 1 2\nusemtl green\np 3\n");
+  Result<Mesh> drawn = load_obj(path("draw.obj"));
+  ASSERT_TRUE(drawn.ok()) << drawn.status().message();
+  Framebuffer fb(64, 64);
+  fb.clear_color(glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+  fb.clear_depth(1.0f);
+  Camera camera;
+  camera.eye = {0.0f, 0.0f, 4.0f};
+  camera.target = {0.0f, 0.0f, 0.0f};
+  render_mesh(fb, *drawn, camera, RenderOptions{});
+  Image image = fb.to_image();
+  int red = 0, green = 0, other = 0, red_rows_lo = 64, red_rows_hi = -1, green_y = -1;
+  for (int y = 0; y < 64; ++y) {
+    for (int x = 0; x < 64; ++x) {
+      const uint8_t* p = image.pixel(x, y);
+      if (p[0] == 255 && p[1] == 0 && p[2] == 0) {
+        ++red, red_rows_lo = std::min(red_rows_lo, y), red_rows_hi = std::max(red_rows_hi, y);
+      } else if (p[0] == 0 && p[1] == 255 && p[2] == 0) {
+        ++green, green_y = y;
+      } else if (p[0] || p[1] || p[2]) {
+        ++other;
+      }
+    }
+  }
+  EXPECT_EQ(red_rows_lo, red_rows_hi);  // one row
+  EXPECT_NEAR(red_rows_lo, 32, 1);
+  EXPECT_GT(red, 25);  // 2 units at distance 4 with a 45-degree field: about 39 pixels
+  EXPECT_EQ(green, 1);
+  EXPECT_LT(green_y, red_rows_lo - 5);
+  EXPECT_EQ(other, 0);
+}
+
 TEST_F(IoTest, ObjErrors) {
   struct Case {
     const char* name;
@@ -549,9 +609,12 @@ TEST_F(IoTest, ObjErrors) {
   };
   const Case cases[] = {
       {"empty.obj", "", "no faces"},
-      {"points.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n",
-       "no faces: 2 vertices but no face (f) to draw; softrast draws faces, not points (p) or "
-       "lines (l)"},
+      {"vertices.obj", "v 0 0 0\nv 1 0 0\n",
+       "no faces: 2 vertices but no face (f), line (l) or points (p) to draw"},
+      {"short_line.obj", std::string(kQuadPositions) + "l 1\n",
+       ":5: line (l) with fewer than 2 vertices"},
+      {"no_point.obj", std::string(kQuadPositions) + "p\n", ":5: points (p) without a vertex"},
+      {"line_range.obj", std::string(kQuadPositions) + "l 1 5\n", "out of range"},
       {"big.obj", std::string(kQuadPositions) + "f 1 2 5\n", "out of range"},
       {"neg.obj", std::string(kQuadPositions) + "f 1 2 -5\n", "out of range"},
       {"uv.obj", std::string(kQuadPositions) + "vt 0 0\nf 1/1 2/2 3/1\n", "out of range"},
@@ -640,7 +703,7 @@ TEST_F(IoTest, ObjNumbersTinyobjOverflowedOnAreErrorsOrSkipped) {
   ASSERT_FALSE(mesh.ok());
   EXPECT_EQ(mesh.status().message(), path("e.obj") + ":1: 'x' is not a number");
   // Statements softrast does not use are skipped unread, whatever their numbers.
-  write("e.obj", std::string(kQuadPositions) + "vw 0 1e39 0.5\nl 1 99999999999999999999\n" +
+  write("e.obj", std::string(kQuadPositions) + "vw 0 1e39 0.5\ncurv 1 99999999999999999999\n" +
                      "vp 1e2147483648\nf 1 2 3 # a comment\n");
   mesh = load_obj(path("e.obj"));
   ASSERT_TRUE(mesh.ok()) << mesh.status().message();

@@ -192,6 +192,8 @@ ojson geometry_json(const Mesh& mesh) {
     submeshes.push_back({{"material", nullptr}, {"triangles", mesh.triangle_count()}});
   }
   return {{"triangles", mesh.triangle_count()},
+          {"line_segments", mesh.line_indices.size() / 2},
+          {"points", mesh.point_indices.size()},
           {"vertices", mesh.vertex_count()},
           {"bounds",
            {{"min", vec3_json(lo)},
@@ -254,6 +256,10 @@ std::string found_text(const ojson& r) {
 
 void print_geometry(const ojson& info) {
   std::printf("  triangles  %s\n", info["triangles"].dump().c_str());
+  if (info.value("line_segments", 0) > 0) {
+    std::printf("  lines      %s segments\n", info["line_segments"].dump().c_str());
+  }
+  if (info.value("points", 0) > 0) std::printf("  points     %s\n", info["points"].dump().c_str());
   if (info.contains("file")) {  // an OBJ: what its statements count
     const ojson& f = info["file"];
     std::printf(

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "scene_files.hpp"
 #include "softrast/image.hpp"
 #include "softrast/renderer.hpp"
 #include "softrast/simd_level.hpp"
@@ -166,8 +167,7 @@ Status run_job(Job& job) {
       std::fprintf(stderr, "softrast: warning: %s\n", warning.c_str());
     }
   }
-  progress(job, "loaded " + job.scene.source + ": " +
-                    std::to_string(job.scene.mesh.triangle_count()) + " triangles in " +
+  progress(job, "loaded " + job.scene.source + ": " + element_counts(job.scene.mesh) + " in " +
                     format("%.1f", job.scene.load_ms) + " ms");
   if (job.frames > 0) {
     if (Status s = benchmark(job); !s.ok()) return s;

@@ -90,12 +90,41 @@ Result<std::vector<std::string>> expand_model_paths(const std::vector<std::strin
   return paths;
 }
 
+std::string element_counts(const Mesh& mesh) {
+  std::string text = std::to_string(mesh.triangle_count()) + " triangles";
+  if (!mesh.line_indices.empty()) {
+    text += ", " + std::to_string(mesh.line_indices.size() / 2) + " line segments";
+  }
+  if (!mesh.point_indices.empty())
+    text += ", " + std::to_string(mesh.point_indices.size()) + " points";
+  return text;
+}
+
+// One kind of element of `part` (triangles, lines or points) appended to the scene's: indices
+// shifted past the scene's vertices, runs past its indices and materials (a part without runs is
+// one run of the default material).
+void append_elements(std::vector<uint32_t>& indices, std::vector<SubMesh>& runs,
+                     const std::vector<uint32_t>& part_indices,
+                     const std::vector<SubMesh>& part_runs, uint32_t base, int material_base) {
+  if (part_indices.empty()) return;
+  const uint32_t first = uint32_t(indices.size());
+  for (uint32_t i : part_indices) indices.push_back(base + i);
+  if (part_runs.empty()) runs.push_back({first, uint32_t(part_indices.size()), -1});
+  for (SubMesh run : part_runs) {
+    run.first_index += first;
+    if (run.material >= 0) run.material += material_base;
+    runs.push_back(run);
+  }
+}
+
 Status append_mesh(Mesh& scene, const Mesh& part) {
   size_t base = scene.positions.size();
-  if (base + part.positions.size() > size_t(UINT32_MAX)) {
-    return Status::error("the scene has more than 2^32 vertices");
+  if (base + part.positions.size() > size_t(UINT32_MAX) ||
+      scene.indices.size() + part.indices.size() > size_t(UINT32_MAX) ||
+      scene.line_indices.size() + part.line_indices.size() > size_t(UINT32_MAX) ||
+      scene.point_indices.size() + part.point_indices.size() > size_t(UINT32_MAX)) {
+    return Status::error("the scene has more than 2^32 vertices or indices");
   }
-  uint32_t first = uint32_t(scene.indices.size());
   int material_base = int(scene.materials.size());
   scene.positions.insert(scene.positions.end(), part.positions.begin(), part.positions.end());
   scene.normals.insert(scene.normals.end(), part.normals.begin(), part.normals.end());
@@ -106,16 +135,23 @@ Status append_mesh(Mesh& scene, const Mesh& part) {
   } else {
     scene.tangents.clear();
   }
+  // Vertex colours where any part has them: white for the vertices of parts without.
+  const bool part_colored = part.colors.size() == part.positions.size() && !part.colors.empty();
+  if (part_colored || !scene.colors.empty()) {
+    scene.colors.resize(base, glm::vec4(1.0f));
+    if (part_colored) {
+      scene.colors.insert(scene.colors.end(), part.colors.begin(), part.colors.end());
+    } else {
+      scene.colors.resize(scene.positions.size(), glm::vec4(1.0f));
+    }
+  }
   scene.materials.insert(scene.materials.end(), part.materials.begin(), part.materials.end());
-  for (uint32_t i : part.indices) scene.indices.push_back(uint32_t(base) + i);
-  if (part.submeshes.empty()) {
-    scene.submeshes.push_back({first, uint32_t(part.indices.size()), -1});
-  }
-  for (SubMesh run : part.submeshes) {
-    run.first_index += first;
-    if (run.material >= 0) run.material += material_base;
-    scene.submeshes.push_back(run);
-  }
+  append_elements(scene.indices, scene.submeshes, part.indices, part.submeshes, uint32_t(base),
+                  material_base);
+  append_elements(scene.line_indices, scene.line_submeshes, part.line_indices, part.line_submeshes,
+                  uint32_t(base), material_base);
+  append_elements(scene.point_indices, scene.point_submeshes, part.point_indices,
+                  part.point_submeshes, uint32_t(base), material_base);
   return {};
 }
 

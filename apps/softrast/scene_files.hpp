@@ -39,6 +39,10 @@ using ModelLoader = std::function<Result<Mesh>(const std::string& path)>;
 Result<LoadedModels> load_models(const std::vector<std::string>& paths,
                                  const ModelLoader& load = {});
 
+// What the mesh draws, for progress lines: "12 triangles", or with its lines and points
+// "0 triangles, 24 line segments, 8 points".
+std::string element_counts(const Mesh& mesh);
+
 // Appends `part` to `scene`: vertices after the scene's, its materials after the scene's (so
 // equal material names in two files stay two materials), its runs re-based.
 Status append_mesh(Mesh& scene, const Mesh& part);

@@ -20,6 +20,7 @@
 #include "progress.hpp"
 #include "report.hpp"
 #include "run.hpp"
+#include "scene_files.hpp"
 #include "setup.hpp"
 
 namespace softrast::cli {
@@ -243,8 +244,8 @@ int sequence_command(const RawArgs& a) {
     return kExitRuntime;
   }
   if (!a.quiet) {
-    std::fprintf(stderr, "loaded %s: %zu triangles in %.1f ms\n", job->scene.source.c_str(),
-                 job->scene.mesh.triangle_count(), job->scene.load_ms);
+    std::fprintf(stderr, "loaded %s: %s in %.1f ms\n", job->scene.source.c_str(),
+                 element_counts(job->scene.mesh).c_str(), job->scene.load_ms);
   }
   Bounds bounds = bounds_of(job->scene.mesh);
   int frames = int(paths->size());

@@ -24,6 +24,7 @@
 #include "debug_flag.hpp"
 #include "framing.hpp"
 #include "orbit.hpp"
+#include "scene_files.hpp"
 #include "setup.hpp"
 #include "softrast/image.hpp"
 #include "softrast/renderer.hpp"
@@ -41,29 +42,6 @@ constexpr int kExitRuntime = 1;
 constexpr int kExitUsage = 2;
 constexpr const char* kDefaultWindowSize = "1280x720";
 constexpr int kMaxFrames = 1000000;
-
-// Appends `src` to `dst`: indices, runs and materials shifted past what `dst` holds.
-void append_mesh(Mesh& dst, Mesh src) {
-  auto runs_of = [](const Mesh& m) {
-    return m.submeshes.empty() && !m.indices.empty()
-               ? std::vector<SubMesh>{{0, uint32_t(m.indices.size()), -1}}
-               : m.submeshes;
-  };
-  dst.submeshes = runs_of(dst);
-  uint32_t first_vertex = uint32_t(dst.positions.size());
-  uint32_t first_index = uint32_t(dst.indices.size());
-  int first_material = int(dst.materials.size());
-  for (SubMesh run : runs_of(src)) {
-    run.first_index += first_index;
-    if (run.material >= 0) run.material += first_material;
-    dst.submeshes.push_back(run);
-  }
-  for (uint32_t i : src.indices) dst.indices.push_back(i + first_vertex);
-  dst.positions.insert(dst.positions.end(), src.positions.begin(), src.positions.end());
-  dst.normals.insert(dst.normals.end(), src.normals.begin(), src.normals.end());
-  dst.uvs.insert(dst.uvs.end(), src.uvs.begin(), src.uvs.end());
-  for (Material& m : src.materials) dst.materials.push_back(std::move(m));
-}
 
 // The scene shown: the models side by side in world space, or the demo scene.
 struct ViewScene {
@@ -85,11 +63,9 @@ Result<ViewScene> load_view_scene(const std::vector<std::string>& models, float 
     scene.source = "demo scene";
     return scene;
   }
-  for (const std::string& path : models) {
-    Result<Mesh> mesh = load_model(path);
-    if (!mesh) return mesh.status();
-    append_mesh(scene.mesh, std::move(*mesh));
-  }
+  Result<LoadedModels> loaded = load_models(models);  // merged as `softrast render` merges them
+  if (!loaded) return loaded.status();
+  scene.mesh = std::move(loaded->mesh);
   scene.bounds = bounds_of(scene.mesh);
   scene.camera = frame_model(scene.bounds, CameraFlags{}, aspect);
   scene.source = models.size() == 1 ? models.front() : std::to_string(models.size()) + " models";

@@ -54,8 +54,8 @@ struct Material {
 
 // A run of indices drawn with one material.
 struct SubMesh {
-  uint32_t first_index = 0;  // into Mesh::indices
-  uint32_t index_count = 0;  // a multiple of 3
+  uint32_t first_index = 0;  // into Mesh::indices (line_indices, point_indices for those runs)
+  uint32_t index_count = 0;  // a multiple of 3 (of 2 for lines)
   int material = -1;         // into Mesh::materials, or -1 for the default material
 };
 
@@ -75,6 +75,14 @@ struct Mesh {
   std::vector<glm::vec2> uvs1;     // a second texture coordinate set (glTF TEXCOORD_1)
   std::vector<uint32_t> indices;   // three per triangle
   std::vector<SubMesh> submeshes;  // cover `indices`; empty means one run with material -1
+  // Lines and points of the file (OBJ's l and p; glTF's LINES, LINE_LOOP, LINE_STRIP and POINTS):
+  // two indices per segment and one per point, into the same vertices, in runs of one material as
+  // `submeshes` (empty: one run with material -1). render_mesh draws them after the triangles,
+  // one pixel wide, unlit in the material's diffuse colour (or the vertex colours), depth-tested.
+  std::vector<uint32_t> line_indices;
+  std::vector<SubMesh> line_submeshes;
+  std::vector<uint32_t> point_indices;
+  std::vector<SubMesh> point_submeshes;
   std::vector<Material> materials;
   // Problems the loader worked around, one line each ("model.obj:1: ..."): a missing MTL library,
   // a missing or unreadable map_Kd texture. The mesh is usable; a program shows these to the user.

@@ -235,6 +235,8 @@ class ObjMerge {
   template <class KeyOf>
   void add_polygon(const ObjCorner* c, size_t n, const KeyOf& key_of,
                    std::vector<uint32_t>& indices);
+  template <class KeyOf>
+  void add_line_or_points(const ObjCorner* c, size_t n, bool points, const KeyOf& key_of);
   Mesh build_mesh();
 
   const std::string& path_;
@@ -248,7 +250,10 @@ class ObjMerge {
   size_t index_count_ = 0;
   std::vector<SubMesh> submeshes_;
   int material_ = -1;
-  size_t face_ = 0, corner_ = 0;  // cursor in the piece being merged
+  size_t face_ = 0, corner_ = 0, other_ = 0;  // cursor in the piece being merged
+  // The l and p elements, as Mesh::line_indices and point_indices with their runs.
+  std::vector<uint32_t> line_indices_, point_indices_;
+  std::vector<SubMesh> line_submeshes_, point_submeshes_;
   // add_polygon's scratch: a face's vertices, positions and triangles (as corner numbers).
   std::vector<uint32_t> polygon_vertices_, polygon_triangles_;
   std::vector<glm::vec3> polygon_points_;
@@ -307,7 +312,31 @@ void ObjMerge::add_polygon(const ObjCorner* c, size_t n, const KeyOf& key_of,
   for (uint32_t corner : polygon_triangles_) indices.push_back(polygon_vertices_[corner]);
 }
 
-// Adds faces [face_, end_face) of the piece: a triangle as it is, a polygon by add_polygon.
+// An l element's segments (each corner to the next) or a p element's points, in runs of the
+// current material as the faces' submeshes are.
+template <class KeyOf>
+void ObjMerge::add_line_or_points(const ObjCorner* c, size_t n, bool points, const KeyOf& key_of) {
+  std::vector<uint32_t>& out = points ? point_indices_ : line_indices_;
+  std::vector<SubMesh>& runs = points ? point_submeshes_ : line_submeshes_;
+  if (runs.empty() || runs.back().material != material_) {
+    runs.push_back({uint32_t(out.size()), 0, material_});
+  }
+  uint32_t previous = table_.vertex(key_of(c[0]));
+  if (points) out.push_back(previous);
+  for (size_t k = 1; k < n; ++k) {
+    uint32_t current = table_.vertex(key_of(c[k]));
+    if (points) {
+      out.push_back(current);
+    } else {
+      out.insert(out.end(), {previous, current});
+    }
+    previous = current;
+  }
+  runs.back().index_count = uint32_t(out.size() - runs.back().first_index);
+}
+
+// Adds faces [face_, end_face) of the piece: a triangle as it is, a polygon by add_polygon, and
+// the l and p elements among them by add_line_or_points.
 void ObjMerge::add_faces(const ObjPiece& piece, const size_t offset[3], size_t end_face,
                          std::vector<uint32_t>& indices) {
   auto key_of = [&](const ObjCorner& c) {
@@ -320,6 +349,11 @@ void ObjMerge::add_faces(const ObjPiece& piece, const size_t offset[3], size_t e
   };
   for (; face_ < end_face; ++face_) {
     size_t n = piece.face_sizes[face_];
+    if (other_ < piece.others.size() && piece.others[other_].face == face_) {
+      add_line_or_points(&piece.corners[corner_], n, piece.others[other_++].points, key_of);
+      corner_ += n;
+      continue;
+    }
     if (submeshes_.empty() || submeshes_.back().material != material_) {
       submeshes_.push_back({uint32_t(index_count_ + indices.size()), 0, material_});
     }
@@ -371,7 +405,7 @@ Status ObjMerge::merge(ObjPiece& piece) {
   table_.grow_positions(values_[0].count());
   std::vector<uint32_t> indices;
   indices.reserve(3 * piece.triangles);
-  face_ = corner_ = 0;
+  face_ = corner_ = other_ = 0;
   for (const detail::ObjEvent& event : piece.events) {
     add_faces(piece, offset, event.face, indices);
     if (!event.mtllib) {
@@ -394,6 +428,10 @@ Status ObjMerge::merge(ObjPiece& piece) {
 Mesh ObjMerge::build_mesh() {
   Mesh mesh;
   mesh.submeshes = std::move(submeshes_);
+  mesh.line_indices = std::move(line_indices_);
+  mesh.line_submeshes = std::move(line_submeshes_);
+  mesh.point_indices = std::move(point_indices_);
+  mesh.point_submeshes = std::move(point_submeshes_);
   table_.release_lookup();
   const std::vector<VertexTable::Key>& keys = table_.keys();
   mesh.positions.resize(keys.size());
@@ -462,14 +500,13 @@ Mesh ObjMerge::build_mesh() {
 }
 
 Result<Mesh> ObjMerge::finish() {
-  if (index_count_ == 0) {
+  if (index_count_ == 0 && line_indices_.empty() && point_indices_.empty()) {
     size_t vertices = values_[0].count();
     if (vertices == 0) return fail(path_, "no faces");
-    // Points and lines (p, l) are not drawn: say so, rather than only what is missing.
+    // Vertices alone: say so, rather than only what is missing.
     return fail(path_, "no faces: " + std::to_string(vertices) +
                            (vertices == 1 ? " vertex" : " vertices") +
-                           " but no face (f) to draw; softrast draws faces, not points (p) or "
-                           "lines (l)");
+                           " but no face (f), line (l) or points (p) to draw");
   }
   // Positive indices may name elements defined further down: checked against the final counts.
   for (int a = 0; a < 3; ++a) {
@@ -488,6 +525,8 @@ Result<Mesh> ObjMerge::finish() {
     if (std::optional<Material> m = detail::tutorial_material(path_, warnings)) {
       mesh.materials.push_back(std::move(*m));
       for (SubMesh& run : mesh.submeshes) run.material = 0;
+      for (SubMesh& run : mesh.line_submeshes) run.material = 0;
+      for (SubMesh& run : mesh.point_submeshes) run.material = 0;
     }
   }
   mesh.warnings = std::move(warnings);

@@ -1,5 +1,5 @@
-// io/obj_piece.cpp: parsing one piece of an OBJ file (see obj_piece.hpp). Only v, vt, vn, f,
-// usemtl and mtllib are read; every other statement (o, g, s, l, p, vw, ...) is skipped unparsed.
+// io/obj_piece.cpp: parsing one piece of an OBJ file (see obj_piece.hpp). Only v, vt, vn, f, l,
+// p, usemtl and mtllib are read; every other statement (o, g, s, vw, ...) is skipped unparsed.
 
 #include "io/obj_piece.hpp"
 
@@ -86,6 +86,9 @@ class PieceParser {
     std::string_view keyword = words.next();
     if (keyword.size() == 1 && keyword[0] == 'v') return numbers(words, kObjPositions, 3);
     if (keyword.size() == 1 && keyword[0] == 'f') return face(words);
+    if (keyword.size() == 1 && (keyword[0] == 'l' || keyword[0] == 'p')) {
+      return line_or_points(words, keyword[0] == 'p');
+    }
     if (keyword == "vt") return numbers(words, kObjUvs, 1);
     if (keyword == "vn") return numbers(words, kObjNormals, 3);
     if (keyword == "usemtl") {  // the name's words, one space apart (a name may hold spaces)
@@ -219,6 +222,21 @@ class PieceParser {
     if (n < 3) return error("face with fewer than 3 vertices");
     p_.face_sizes.push_back(uint32_t(n));
     p_.triangles += n - 2;
+    return true;
+  }
+
+  // "l v1 v2 ..." (a polyline) or "p v1 v2 ...": corners as a face's (a uv or normal is read and
+  // not used), kept among the faces in file order.
+  bool line_or_points(ObjWords& words, bool points) {
+    size_t first = p_.corners.size();
+    for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
+      if (!corner(w)) return false;
+    }
+    size_t n = p_.corners.size() - first;
+    if (points && n < 1) return error("points (p) without a vertex");
+    if (!points && n < 2) return error("line (l) with fewer than 2 vertices");
+    p_.others.push_back({p_.face_sizes.size(), points});
+    p_.face_sizes.push_back(uint32_t(n));
     return true;
   }
 

@@ -65,6 +65,13 @@ struct ObjLargest {
   size_t line = 0;
 };
 
+// A line (l) or points (p) element among a piece's faces: its corners are in ObjPiece::corners
+// and its size in face_sizes, in file order with the faces; this says which it is.
+struct ObjOther {
+  size_t face;  // into face_sizes
+  bool points;  // else a polyline
+};
+
 struct ObjPiece {
   std::vector<char> text;  // whole lines; freed once parsed
   bool bad_alloc = false;  // parsing ran out of memory: the merge rethrows
@@ -75,8 +82,9 @@ struct ObjPiece {
   // for positions without; empty when no position of the piece has one.
   std::vector<float> colors;
   std::vector<ObjCorner> corners;    // every face's corners in order
-  std::vector<uint32_t> face_sizes;  // corners per face
-  size_t triangles = 0;              // sum of face_sizes[i] - 2
+  std::vector<uint32_t> face_sizes;  // corners per face (per line or points element too)
+  size_t triangles = 0;              // sum of face_sizes[i] - 2 over the faces
+  std::vector<ObjOther> others;      // the l and p elements among them, in order
   std::vector<ObjFixup> fixups;      // in line order
   std::vector<ObjEvent> events;      // in line order
   ObjLargest largest[3];

@@ -220,6 +220,37 @@ DepthRange visible_depth_range(int width, int height, const Mesh& mesh, const Ca
 // A mesh whose normals and uvs match its positions (the built-in shaders read all three), and
 // its tangents when `tangents` (loaders compute them for their normal maps: this is the
 // fallback for meshes built otherwise).
+// The mesh's lines and points (OBJ's l and p, glTF's line and point modes), after its triangles:
+// one pixel wide, unlit in each run's diffuse colour (or the vertex colours, as the flat shader
+// draws them), depth-tested as the triangles are, never culled.
+void draw_lines_and_points(Framebuffer& fb, const RenderState& triangles, const Mesh& mesh,
+                           const Camera& camera, const glm::mat4& mvp, const RenderOptions& opt,
+                           DepthRange depth) {
+  struct Kind {
+    Primitive primitive;
+    const std::vector<uint32_t>& indices;
+    const std::vector<SubMesh>& runs;
+  };
+  for (const Kind& kind : {Kind{Primitive::kLines, mesh.line_indices, mesh.line_submeshes},
+                           Kind{Primitive::kPoints, mesh.point_indices, mesh.point_submeshes}}) {
+    if (kind.indices.empty()) continue;
+    RenderState state = triangles;
+    state.primitive = kind.primitive;
+    state.wireframe = false;
+    state.cull = CullMode::kNone;
+    std::vector<SubMesh> runs = kind.runs;
+    if (runs.empty()) runs.push_back({0, uint32_t(kind.indices.size()), -1});
+    for (const SubMesh& run : runs) {
+      if (size_t(run.first_index) + run.index_count > kind.indices.size()) continue;
+      Surface surf = surface_of(mesh, run.material, opt);
+      surf.maps = {};
+      surf.texture = nullptr;
+      std::span<const uint32_t> indices(kind.indices.data() + run.first_index, run.index_count);
+      draw_run(fb, state, mesh, camera, mvp, indices, surf, opt, ShaderKind::kFlat, depth);
+    }
+  }
+}
+
 const Mesh& complete_mesh(const Mesh& mesh, Mesh& storage, bool tangents) {
   size_t n = mesh.positions.size();
   bool need_tangents = tangents && mesh.tangents.size() != n;
@@ -293,6 +324,7 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
       }
     }
   }
+  draw_lines_and_points(framebuffer, state, mesh, camera, mvp, options, depth);
   if (options.wireframe_overlay && options.shader != ShaderKind::kWireframe) {
     RenderState wire = options.state;
     wire.wireframe = true;
