@@ -116,6 +116,39 @@ TEST_F(GltfTest, TextureTransformTurnsAsTheExtensionsExampleSays) {
   }
 }
 
+// The line and point modes: the cube's 36 indices as LINES (18 segments), LINE_STRIP (35),
+// LINE_LOOP (36, the last back to the first) and POINTS (36), each index where the triangles would
+// have it.
+TEST_F(GltfTest, LineAndPointModesBecomeLinesAndPoints) {
+  Result<Mesh> triangles = load_model(write("tri.gltf", test::as_gltf(test::textured_cube(png_))));
+  ASSERT_TRUE(triangles.ok()) << triangles.status().message();
+  struct Mode {
+    int mode;
+    size_t segments, points;
+  };
+  for (Mode m : {Mode{1, 18, 0}, Mode{3, 35, 0}, Mode{2, 36, 0}, Mode{0, 0, 36}}) {
+    GltfParts g = test::textured_cube(png_);
+    g.json["meshes"][0]["primitives"][0]["mode"] = m.mode;
+    Result<Mesh> mesh = load_model(write("mode.gltf", test::as_gltf(g)));
+    ASSERT_TRUE(mesh.ok()) << m.mode << ": " << mesh.status().message();
+    EXPECT_EQ(mesh->triangle_count(), 0u) << m.mode;
+    ASSERT_EQ(mesh->line_indices.size(), 2 * m.segments) << m.mode;
+    ASSERT_EQ(mesh->point_indices.size(), m.points) << m.mode;
+    // The file's index order, on vertices placed as the triangles' were (the node transforms).
+    std::vector<glm::vec3> file_order;
+    for (uint32_t i : triangles->indices) file_order.push_back(triangles->positions[i]);
+    // Corner k of the list: where the triangles' corner k is (LINES pairs the list, the strip and
+    // the loop join each corner to the next).
+    auto at = [&](uint32_t i) { return mesh->positions[i]; };
+    for (size_t k = 0; k < m.points; ++k) EXPECT_EQ(at(mesh->point_indices[k]), file_order[k]) << k;
+    for (size_t j = 0; j < m.segments; ++j) {
+      size_t a = m.mode == 1 ? 2 * j : j, b = (a + 1) % file_order.size();
+      EXPECT_EQ(at(mesh->line_indices[2 * j]), file_order[a]) << m.mode << " " << j;
+      EXPECT_EQ(at(mesh->line_indices[2 * j + 1]), file_order[b]) << m.mode << " " << j;
+    }
+  }
+}
+
 // Node 0 translates by (0.25, 0, 0); its child node 1 turns by 30 degrees about y and scales by
 // 0.8: every loaded corner is T * R * S of a corner of the unit cube.
 TEST_F(GltfTest, NodeTransformsPlaceEveryVertex) {
@@ -372,12 +405,12 @@ std::vector<BadCase> bad_cases() {
          return test::as_gltf(g);
        },
        "mesh 0 primitive 0: index 99 is past the vertex count 24 (accessor 3)"},
-      {"OnlyLines", "lines.gltf",
+      {"NoPrimitiveMode", "mode9.gltf",
        [](GltfParts g, const std::string&) {
-         g.json["meshes"][0]["primitives"][0]["mode"] = 1;  // LINES
+         g.json["meshes"][0]["primitives"][0]["mode"] = 9;  // past TRIANGLE_FAN (6)
          return test::as_gltf(g);
        },
-       "no triangles to draw: its 1 primitive is points or lines, which softrast does not draw"},
+       "nothing to draw: its 1 primitive has no glTF primitive mode"},
       {"PositionsAsMatrices", "mat4.gltf",
        [](GltfParts g, const std::string&) {
          g.json["accessors"][0]["type"] = "MAT4";

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/mat3x3.hpp>
@@ -481,6 +482,8 @@ Material material_of(const tg::Material& g, TextureCache& cache) {
 struct Piece {
   std::vector<glm::vec4> positions, normals, tangents, uvs, uvs1, colors;
   std::vector<uint32_t> triangles;  // three per triangle
+  std::vector<uint32_t> lines;      // two per segment (LINES, LINE_STRIP, LINE_LOOP)
+  std::vector<uint32_t> points;     // one per point (POINTS)
 };
 
 Status check_finite(const std::vector<glm::vec4>& values, const std::string& what) {
@@ -557,7 +560,21 @@ Status read_piece(const tg::Model& m, const tg::Primitive& p, const std::string&
     indices.resize(count);
     for (size_t i = 0; i < count; ++i) indices[i] = uint32_t(i);
   }
-  triangulate(p.mode == -1 ? TINYGLTF_MODE_TRIANGLES : p.mode, indices, out.triangles);
+  const int mode = p.mode == -1 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+  if (mode == TINYGLTF_MODE_POINTS) {
+    out.points = std::move(indices);
+  } else if (mode == TINYGLTF_MODE_LINE) {
+    out.lines.assign(indices.begin(), indices.begin() + ptrdiff_t(indices.size() / 2 * 2));
+  } else if (mode == TINYGLTF_MODE_LINE_STRIP || mode == TINYGLTF_MODE_LINE_LOOP) {
+    for (size_t i = 1; i < indices.size(); ++i) {
+      out.lines.insert(out.lines.end(), {indices[i - 1], indices[i]});
+    }
+    if (mode == TINYGLTF_MODE_LINE_LOOP && indices.size() > 2) {
+      out.lines.insert(out.lines.end(), {indices.back(), indices.front()});
+    }
+  } else {
+    triangulate(mode, indices, out.triangles);
+  }
   return {};
 }
 
@@ -606,7 +623,7 @@ void add_tangents(Piece& piece) {
 struct Builder {
   Mesh mesh;
   bool any_tangents = false, any_uvs1 = false, any_colors = false;
-  int skipped_points_and_lines = 0;  // primitives not drawn (their warning names each)
+  int skipped_primitives = 0;  // primitives of no glTF mode, not drawn (a warning names each)
   std::vector<glm::vec4> tangents, colors;
   std::vector<glm::vec2> uvs1;
 };
@@ -620,7 +637,7 @@ bool needs_tangents(const Mesh& mesh, int material) {
 // Appends a piece transformed by `world` as a submesh of `material`.
 Status append(Builder& b, Piece& piece, const glm::mat4& world, int material,
               const std::string& what) {
-  if (piece.triangles.empty()) return {};
+  if (piece.triangles.empty() && piece.lines.empty() && piece.points.empty()) return {};
   size_t base = b.mesh.positions.size();
   // Checked before flat normals multiply the vertices (three per triangle) as well as after.
   size_t added = piece.normals.empty() ? piece.triangles.size() : piece.positions.size();
@@ -629,7 +646,8 @@ Status append(Builder& b, Piece& piece, const glm::mat4& world, int material,
     return fail(what, "the scene has more than " + n(kMaxGltfVertices) + " vertices or " +
                           n(kMaxGltfTriangles) + " triangles once its nodes are flattened");
   }
-  if (piece.normals.empty()) make_flat(piece);
+  if (piece.normals.empty() && !piece.triangles.empty()) make_flat(piece);
+  if (piece.normals.empty()) piece.normals.assign(piece.positions.size(), glm::vec4(0, 0, 1, 0));
   if (piece.tangents.empty() && needs_tangents(b.mesh, material)) add_tangents(piece);
   glm::mat3 linear(world);
   glm::mat3 normal_matrix = glm::transpose(glm::inverse(linear));
@@ -669,14 +687,24 @@ Status append(Builder& b, Piece& piece, const glm::mat4& world, int material,
       b.colors.push_back(piece.colors[i]);
     }
   }
-  SubMesh sub{uint32_t(b.mesh.indices.size()), uint32_t(piece.triangles.size()), material};
-  for (size_t t = 0; t < piece.triangles.size(); t += 3) {
-    uint32_t i0 = uint32_t(base) + piece.triangles[t], i1 = uint32_t(base) + piece.triangles[t + 1],
-             i2 = uint32_t(base) + piece.triangles[t + 2];
-    if (det < 0.0f) std::swap(i1, i2);  // a mirroring node turns its faces clockwise: undo it
-    b.mesh.indices.insert(b.mesh.indices.end(), {i0, i1, i2});
+  if (!piece.triangles.empty()) {
+    SubMesh sub{uint32_t(b.mesh.indices.size()), uint32_t(piece.triangles.size()), material};
+    for (size_t t = 0; t < piece.triangles.size(); t += 3) {
+      uint32_t i0 = uint32_t(base) + piece.triangles[t],
+               i1 = uint32_t(base) + piece.triangles[t + 1],
+               i2 = uint32_t(base) + piece.triangles[t + 2];
+      if (det < 0.0f) std::swap(i1, i2);  // a mirroring node turns its faces clockwise: undo it
+      b.mesh.indices.insert(b.mesh.indices.end(), {i0, i1, i2});
+    }
+    b.mesh.submeshes.push_back(sub);
   }
-  b.mesh.submeshes.push_back(sub);
+  for (auto [from, to, runs] :
+       {std::tuple{&piece.lines, &b.mesh.line_indices, &b.mesh.line_submeshes},
+        std::tuple{&piece.points, &b.mesh.point_indices, &b.mesh.point_submeshes}}) {
+    if (from->empty()) continue;
+    runs->push_back({uint32_t(to->size()), uint32_t(from->size()), material});
+    for (uint32_t i : *from) to->push_back(uint32_t(base) + i);
+  }
   return {};
 }
 
@@ -735,16 +763,18 @@ struct Flattener {
     for (size_t k = 0; k < mesh.primitives.size(); ++k) {
       const tg::Primitive& p = mesh.primitives[k];
       std::string pwhat = what + " primitive " + std::to_string(k);
-      if (p.mode != -1 && p.mode != TINYGLTF_MODE_TRIANGLES &&
-          p.mode != TINYGLTF_MODE_TRIANGLE_STRIP && p.mode != TINYGLTF_MODE_TRIANGLE_FAN) {
-        builder.mesh.warnings.push_back(pwhat + ": points and lines are not drawn");
-        ++builder.skipped_points_and_lines;
+      if (p.mode < -1 || p.mode > TINYGLTF_MODE_TRIANGLE_FAN) {
+        builder.mesh.warnings.push_back(pwhat + ": mode " + std::to_string(p.mode) +
+                                        " is not a glTF primitive mode; not drawn");
+        ++builder.skipped_primitives;
         continue;
       }
       if (empty.count({index, k})) continue;
       Piece piece;
       if (Status s = read_piece(model, p, pwhat, piece); !s.ok()) return s;
-      if (piece.triangles.empty()) empty.insert({index, k});
+      if (piece.triangles.empty() && piece.lines.empty() && piece.points.empty()) {
+        empty.insert({index, k});
+      }
       if (Status s = append(builder, piece, world, material_for(p.material), pwhat); !s.ok())
         return s;
     }
@@ -827,13 +857,13 @@ Result<Mesh> gltf_to_mesh(GltfDocument& doc, const std::string& name, const std:
     }
   }
   if (!status.ok()) return fail(name, status.message());
-  if (b.mesh.indices.empty()) {
-    if (b.skipped_points_and_lines > 0) {
-      return fail(name, "no triangles to draw: its " + std::to_string(b.skipped_points_and_lines) +
-                            " primitive" + (b.skipped_points_and_lines == 1 ? " is" : "s are") +
-                            " points or lines, which softrast does not draw");
+  if (b.mesh.indices.empty() && b.mesh.line_indices.empty() && b.mesh.point_indices.empty()) {
+    if (b.skipped_primitives > 0) {
+      return fail(name, "nothing to draw: its " + std::to_string(b.skipped_primitives) +
+                            " primitive" + (b.skipped_primitives == 1 ? " has" : "s have") +
+                            " no glTF primitive mode");
     }
-    return fail(name, "no triangles to draw");
+    return fail(name, "no triangles, lines or points to draw");
   }
   if (b.any_tangents) {
     b.tangents.resize(b.mesh.positions.size(), glm::vec4(1, 0, 0, 1));
