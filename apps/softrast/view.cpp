@@ -586,8 +586,8 @@ int view_command(const ViewArgs& args, void (*report)(std::string message)) {
   }
   if (spec->auto_shader && has_pbr_materials(scene->mesh)) spec->options.shader = ShaderKind::kPbr;
   if (!spec->quiet) {
-    std::fprintf(stderr, "loaded %s: %zu triangles\n", scene->source.c_str(),
-                 scene->mesh.triangle_count());
+    std::fprintf(stderr, "loaded %s: %s\n", scene->source.c_str(),
+                 element_counts(scene->mesh).c_str());
   }
   SdlVideo video;
   if (!video.ok) {
