@@ -313,11 +313,18 @@ TEST_F(ModelFormatsTest, MessagesNameTheFileAndPlace) {
                "(truncated)");
   expect_error("c.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty flaot x\nend_header\n",
                ":4: unknown type 'flaot'");
-  // A point cloud (a scanner's PLY): what it is, not only what it lacks.
-  expect_error("cloud.ply",
-               "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-               "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n",
-               ": no faces: a point cloud of 3 vertices; softrast draws faces, not points");
+  // A point cloud (a scanner's PLY) loads as points: every vertex one, in their colours.
+  std::string cloud_path = write("cloud.ply",
+                                 "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                 "property float y\nproperty float z\nproperty uchar red\n"
+                                 "property uchar green\nproperty uchar blue\nend_header\n"
+                                 "0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 255\n");
+  Result<Mesh> cloud = load_model(cloud_path);
+  ASSERT_TRUE(cloud.ok()) << cloud.status().message();
+  EXPECT_EQ(cloud->triangle_count(), 0u);
+  EXPECT_EQ(cloud->point_indices, (std::vector<uint32_t>{0, 1, 2}));
+  ASSERT_EQ(cloud->colors.size(), 3u);
+  EXPECT_EQ(cloud->colors[1], glm::vec4(0, 1, 0, 1));
   std::string stl = stl_binary();
   expect_error("d.stl", stl.substr(0, stl.size() - 10),
                ": binary STL declares 12 triangles (684 bytes) but has 674 bytes (truncated)");

@@ -136,7 +136,8 @@ std::optional<std::string> find_referenced_file(const std::string& folder, const
 // concave one cut by ear clipping). Without normals, smooth normals are computed. Errors name the
 // file and the line (ASCII) or the element and byte (binary): a bad header, counts that need more
 // bytes than the file has (checked before allocating), lists over 65536 items, a number that does
-// not fit its type, a vertex index out of range, no faces.
+// not fit its type, a vertex index out of range, no vertices. Vertices without faces are a point
+// cloud: every vertex one of Mesh::point_indices.
 Result<Mesh> load_ply(const std::string& path);
 
 // Loads an STL file, binary (84 + 50 * count bytes; bytes after the triangles are a warning) or

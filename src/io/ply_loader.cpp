@@ -9,7 +9,8 @@
 // are, both clamped to [0, 1]; any other property is read and dropped. The face element's
 // vertex_indices (or vertex_index) list, of any integer types, cut into triangles as
 // geometry/polygon.hpp says (the fan of a convex face, ear clipping of a concave one). Other
-// elements (edges, materials, ...) are read past.
+// elements (edges, materials, ...) are read past. A file of vertices without faces is a point
+// cloud: every vertex a point (Mesh::point_indices).
 //
 // Robustness: every element count is checked against the bytes left before anything is reserved
 // (a binary element has a known minimum size; an ASCII value takes at least two bytes), list
@@ -674,11 +675,10 @@ Result<Mesh> PlyBuilder::build() {
     if (Status s = read_element(e); !s.ok()) return s;
   }
   if (!body_.at_clean_end()) return body_.error("end");
-  if (mesh_.indices.empty()) {
-    if (vertex_count_ == 0) return fail(name_, "no faces");
-    return fail(name_, "no faces: a point cloud of " + std::to_string(vertex_count_) +
-                           (vertex_count_ == 1 ? " vertex" : " vertices") +
-                           "; softrast draws faces, not points");
+  if (vertex_count_ == 0) return fail(name_, "no faces");
+  if (mesh_.indices.empty()) {  // a point cloud (a scanner's PLY): every vertex a point
+    mesh_.point_indices.resize(size_t(vertex_count_));
+    for (size_t i = 0; i < mesh_.point_indices.size(); ++i) mesh_.point_indices[i] = uint32_t(i);
   }
   for (glm::vec3& n : mesh_.normals) {
     float length = glm::length(n);
