@@ -104,7 +104,7 @@ void clip_ears(const std::vector<Point2>& p, std::vector<uint32_t>& out, uint64_
 
 void triangulate_polygon(const glm::vec3* points, size_t n, std::vector<uint32_t>& out,
                          uint64_t* budget) {
-  std::vector<Point2> projected;
+  thread_local std::vector<Point2> projected;  // reused: a loader calls this once per face
   const uint64_t allowed = std::min<uint64_t>(kEarTests * n * n, budget ? *budget : UINT64_MAX);
   if (n > 3 && n <= kMaxEarCorners && allowed > 0 && project(points, n, projected) &&
       !convex(projected)) {
