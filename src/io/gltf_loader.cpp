@@ -640,7 +640,8 @@ Status append(Builder& b, Piece& piece, const glm::mat4& world, int material,
   if (piece.triangles.empty() && piece.lines.empty() && piece.points.empty()) return {};
   size_t base = b.mesh.positions.size();
   // Checked before flat normals multiply the vertices (three per triangle) as well as after.
-  size_t added = piece.normals.empty() ? piece.triangles.size() : piece.positions.size();
+  size_t added = piece.normals.empty() && !piece.triangles.empty() ? piece.triangles.size()
+                                                                   : piece.positions.size();
   if (base + added > size_t(kMaxGltfVertices) ||
       b.mesh.indices.size() / 3 + piece.triangles.size() / 3 > size_t(kMaxGltfTriangles)) {
     return fail(what, "the scene has more than " + n(kMaxGltfVertices) + " vertices or " +
