@@ -137,6 +137,29 @@ TEST(Materials, NamesWithSpacesAreFound) {
   EXPECT_EQ(mesh->materials[size_t(mesh->submeshes[1].material)].diffuse, glm::vec3(1, 0, 0));
 }
 
+// A library whose file name holds spaces ("mtllib my model.mtl", as Blender writes it) is that one
+// file when it is there; otherwise the words are several libraries, as before.
+TEST(Materials, LibraryNameWithSpacesIsOneFile) {
+  Folder f;
+  f.write("my model.mtl", "newmtl red\nKd 1 0 0\n");
+  f.write("a.obj",
+          std::string("mtllib my model.mtl\n") + kQuadObj + "usemtl red\nf 1/1/1 2/2/1 3/3/1\n");
+  Result<Mesh> mesh = load_obj(f.path("a.obj"));
+  ASSERT_TRUE(mesh.ok()) << mesh.status().message();
+  EXPECT_TRUE(mesh->warnings.empty()) << mesh->warnings[0];
+  ASSERT_EQ(mesh->materials.size(), 1u);
+  EXPECT_EQ(mesh->materials[0].diffuse, glm::vec3(1, 0, 0));
+  // Two libraries on one line still load both.
+  f.write("one.mtl", "newmtl a\nKd 0 1 0\n");
+  f.write("two.mtl", "newmtl b\nKd 0 0 1\n");
+  f.write("b.obj", std::string("mtllib one.mtl two.mtl\n") + kQuadObj +
+                       "usemtl a\nf 1/1/1 2/2/1 3/3/1\nusemtl b\nf 1/1/1 3/3/1 4/4/1\n");
+  Result<Mesh> two = load_obj(f.path("b.obj"));
+  ASSERT_TRUE(two.ok()) << two.status().message();
+  EXPECT_TRUE(two->warnings.empty()) << two->warnings[0];
+  EXPECT_EQ(two->materials.size(), 2u);
+}
+
 // illum 0 and 1 have no specular term, and Ns 0 means no highlight (3ds Max's Max2Mtl writes Ks 0.9
 // with Ns 0 for a material without one; Blinn-Phong would light the whole side white): their Ks
 // becomes 0. illum 2 with an exponent keeps its Ks, and a material that gives neither keeps the

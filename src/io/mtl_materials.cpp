@@ -134,6 +134,11 @@ std::vector<MtlGiven> scan_given(const std::string& text) {
 
 }  // namespace
 
+bool ObjMaterials::library_exists(const std::string& name) const {
+  std::optional<FoundFile> found = find_named_file(obj_dir_, name);
+  return found && found->how != FoundAs::kBeside;
+}
+
 Status ObjMaterials::load_library(const std::string& name, const std::string& obj_path,
                                   size_t obj_line) {
   if (!loaded_.insert(name).second) return {};

@@ -34,6 +34,9 @@ class ObjMaterials {
   // a number tinyobj would overflow on is an error naming the MTL file and line.
   Status load_library(const std::string& name, const std::string& obj_path, size_t obj_line);
 
+  // Whether library `name` is found where load_library would look, as it is named.
+  bool library_exists(const std::string& name) const;
+
   // The material's index, or -1 (the default material) for a name no library defined. A name of
   // several words matches a newmtl line of the same words, however spaced (tinyobj keeps the whole
   // rest of the line as the name: "Hard Shiny Plastic White"); failing that, as OBJ readers that

@@ -224,7 +224,16 @@ class ObjMerge {
  private:
   Status piece_error(const ObjPiece& piece) const;
   Status first_fixup_error(ObjPiece& piece, const size_t offset[3], size_t& line) const;
+  // mtllib's words are the libraries' names; a name with spaces (Blender writes
+  // "mtllib my model.mtl") is the whole line, when a file of that name is there.
   Status load_libraries(const detail::ObjEvent& event) {
+    if (event.names.size() > 1) {
+      std::string whole = event.names[0];
+      for (size_t k = 1; k < event.names.size(); ++k) whole += " " + event.names[k];
+      if (materials_.library_exists(whole)) {
+        return materials_.load_library(whole, path_, lines_ + event.line);
+      }
+    }
     for (const std::string& name : event.names) {
       if (Status s = materials_.load_library(name, path_, lines_ + event.line); !s.ok()) return s;
     }
