@@ -217,9 +217,6 @@ DepthRange visible_depth_range(int width, int height, const Mesh& mesh, const Ca
   return {view_depth(camera, lo), view_depth(camera, hi)};
 }
 
-// A mesh whose normals and uvs match its positions (the built-in shaders read all three), and
-// its tangents when `tangents` (loaders compute them for their normal maps: this is the
-// fallback for meshes built otherwise).
 // The mesh's lines and points (OBJ's l and p, glTF's line and point modes), after its triangles:
 // one pixel wide, unlit in each run's diffuse colour (or the vertex colours, as the flat shader
 // draws them), depth-tested as the triangles are, never culled.
@@ -251,6 +248,9 @@ void draw_lines_and_points(Framebuffer& fb, const RenderState& triangles, const 
   }
 }
 
+// A mesh whose normals and uvs match its positions (the built-in shaders read all three), and
+// its tangents when `tangents` (loaders compute them for their normal maps: this is the
+// fallback for meshes built otherwise).
 const Mesh& complete_mesh(const Mesh& mesh, Mesh& storage, bool tangents) {
   size_t n = mesh.positions.size();
   bool need_tangents = tangents && mesh.tangents.size() != n;
