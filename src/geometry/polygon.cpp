@@ -55,10 +55,6 @@ bool convex(const std::vector<Point2>& p) {
   return true;
 }
 
-void append_fan(size_t n, std::vector<uint32_t>& out) {
-  for (size_t k = 2; k < n; ++k) out.insert(out.end(), {0u, uint32_t(k - 1), uint32_t(k)});
-}
-
 // Ear clipping of counter-clockwise polygon p: corners stay in a ring of links; a corner whose turn
 // is strictly convex and whose triangle with its neighbours holds no other remaining corner (one
 // at the same position as the triangle's own corners aside) is cut off. Stops at three corners,
@@ -101,6 +97,10 @@ void clip_ears(const std::vector<Point2>& p, std::vector<uint32_t>& out, uint64_
 }
 
 }  // namespace
+
+void append_fan(size_t n, std::vector<uint32_t>& out) {
+  for (size_t k = 2; k < n; ++k) out.insert(out.end(), {0u, uint32_t(k - 1), uint32_t(k)});
+}
 
 void triangulate_polygon(const glm::vec3* points, size_t n, std::vector<uint32_t>& out,
                          uint64_t* budget) {

@@ -29,6 +29,9 @@ namespace softrast::detail {
 void triangulate_polygon(const glm::vec3* points, size_t n, std::vector<uint32_t>& out,
                          uint64_t* budget = nullptr);
 
+// The fan around corner 0 of a polygon of n corners: (0, 1, 2), (0, 2, 3), ...
+void append_fan(size_t n, std::vector<uint32_t>& out);
+
 inline constexpr size_t kMaxEarCorners = 256;
 inline constexpr size_t kEarTests = 4;
 inline constexpr uint64_t kFileEarTests = uint64_t(1) << 28;

@@ -134,6 +134,15 @@ std::vector<MtlGiven> scan_given(const std::string& text) {
 
 }  // namespace
 
+int ObjMaterials::id(const std::string& name) const {
+  if (auto it = ids_.find(name); it != ids_.end()) return it->second;
+  if (auto it = spaced_ids_.find(ObjWords(name).joined()); it != spaced_ids_.end()) {
+    return it->second;
+  }
+  size_t space = name.find(' ');
+  return space == name.npos ? -1 : id(name.substr(0, space));
+}
+
 bool ObjMaterials::library_exists(const std::string& name) const {
   std::optional<FoundFile> found = find_named_file(obj_dir_, name);
   return found && found->how != FoundAs::kBeside;
@@ -196,7 +205,7 @@ Status ObjMaterials::load_library(const std::string& name, const std::string& ob
   std::string warn;
   tinyobj::LoadMtl(&ids_, &all_, &in, &warn, nullptr);
   for (const auto& [material, index] : ids_) {
-    auto [it, added] = spaced_ids_.emplace(words_of(material), index);
+    auto [it, added] = spaced_ids_.emplace(ObjWords(material).joined(), index);
     if (!added) it->second = std::min(it->second, index);
   }
   std::vector<MtlGiven> given = scan_given(text);
@@ -205,16 +214,6 @@ Status ObjMaterials::load_library(const std::string& name, const std::string& ob
   given_.insert(given_.end(), given.begin(), given.end());
   dirs_.resize(all_.size(), path.parent_path());
   return {};
-}
-
-std::string ObjMaterials::words_of(const std::string& name) {
-  std::string out;
-  ObjWords words(name);
-  for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
-    if (!out.empty()) out += ' ';
-    out.append(w);
-  }
-  return out;
 }
 
 int ObjMaterials::use(const std::string& name, const std::string& obj_path, size_t obj_line) {

@@ -41,12 +41,7 @@ class ObjMaterials {
   // several words matches a newmtl line of the same words, however spaced (tinyobj keeps the whole
   // rest of the line as the name: "Hard Shiny Plastic White"); failing that, as OBJ readers that
   // take one word do, its first word.
-  int id(const std::string& name) const {
-    if (auto it = ids_.find(name); it != ids_.end()) return it->second;
-    if (auto it = spaced_ids_.find(words_of(name)); it != spaced_ids_.end()) return it->second;
-    size_t space = name.find(' ');
-    return space == name.npos ? -1 : id(name.substr(0, space));
-  }
+  int id(const std::string& name) const;
 
   // The materials with their maps (colour maps as sRGB textures, a grey bump map turned into a
   // normal map); a map that cannot be loaded adds a warning instead. Errors: Kd or Ks not
@@ -66,11 +61,8 @@ class ObjMaterials {
   std::filesystem::path obj_dir_;
   int64_t max_bytes_;
   std::set<std::string> loaded_;
-  // A name's words, one space apart.
-  static std::string words_of(const std::string& name);
-
   std::map<std::string, int> ids_;
-  std::map<std::string, int> spaced_ids_;  // ids_ by words_of(name), the first material of each
+  std::map<std::string, int> spaced_ids_;  // ids_ by the names' words, the first material of each
   std::vector<tinyobj::material_t> all_;
   std::vector<std::filesystem::path> dirs_;
   std::vector<MtlGiven> given_;

@@ -244,6 +244,7 @@ class ObjMerge {
   template <class KeyOf>
   void add_polygon(const ObjCorner* c, size_t n, const KeyOf& key_of,
                    std::vector<uint32_t>& indices);
+  void continue_run(std::vector<SubMesh>& runs, size_t first) const;
   template <class KeyOf>
   void add_line_or_points(const ObjCorner* c, size_t n, bool points, const KeyOf& key_of);
   Mesh build_mesh();
@@ -293,6 +294,13 @@ Status ObjMerge::first_fixup_error(ObjPiece& piece, const size_t offset[3], size
   return {};
 }
 
+// Starts a run of the current material at index `first` of its kind unless the last one has it.
+void ObjMerge::continue_run(std::vector<SubMesh>& runs, size_t first) const {
+  if (runs.empty() || runs.back().material != material_) {
+    runs.push_back({uint32_t(first), 0, material_});
+  }
+}
+
 // A face of n > 3 corners: its vertices in corner order (so numbered as they are met), its
 // triangles from triangulate_polygon (the fan of a convex face; a concave one clipped into ears).
 // A face naming a position not read yet (OBJ allows it) is fanned.
@@ -315,8 +323,7 @@ void ObjMerge::add_polygon(const ObjCorner* c, size_t n, const KeyOf& key_of,
   if (positioned) {
     detail::triangulate_polygon(polygon_points_.data(), n, polygon_triangles_, &ear_tests_);
   } else {
-    for (uint32_t k = 2; k < n; ++k)
-      polygon_triangles_.insert(polygon_triangles_.end(), {0, k - 1, k});
+    detail::append_fan(n, polygon_triangles_);
   }
   for (uint32_t corner : polygon_triangles_) indices.push_back(polygon_vertices_[corner]);
 }
@@ -327,9 +334,7 @@ template <class KeyOf>
 void ObjMerge::add_line_or_points(const ObjCorner* c, size_t n, bool points, const KeyOf& key_of) {
   std::vector<uint32_t>& out = points ? point_indices_ : line_indices_;
   std::vector<SubMesh>& runs = points ? point_submeshes_ : line_submeshes_;
-  if (runs.empty() || runs.back().material != material_) {
-    runs.push_back({uint32_t(out.size()), 0, material_});
-  }
+  continue_run(runs, out.size());
   uint32_t previous = table_.vertex(key_of(c[0]));
   if (points) out.push_back(previous);
   for (size_t k = 1; k < n; ++k) {
@@ -363,9 +368,7 @@ void ObjMerge::add_faces(const ObjPiece& piece, const size_t offset[3], size_t e
       corner_ += n;
       continue;
     }
-    if (submeshes_.empty() || submeshes_.back().material != material_) {
-      submeshes_.push_back({uint32_t(index_count_ + indices.size()), 0, material_});
-    }
+    continue_run(submeshes_, index_count_ + indices.size());
     const ObjCorner* c = &piece.corners[corner_];
     if (n == 3) {
       indices.insert(indices.end(), {table_.vertex(key_of(c[0])), table_.vertex(key_of(c[1])),

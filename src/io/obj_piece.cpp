@@ -92,11 +92,7 @@ class PieceParser {
     if (keyword == "vt") return numbers(words, kObjUvs, 1);
     if (keyword == "vn") return numbers(words, kObjNormals, 3);
     if (keyword == "usemtl") {  // the name's words, one space apart (a name may hold spaces)
-      std::string name(words.next());
-      for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
-        name.append(" ").append(w);
-      }
-      p_.events.push_back({false, p_.face_sizes.size(), line_, {std::move(name)}});
+      p_.events.push_back({false, p_.face_sizes.size(), line_, {words.joined()}});
       return true;
     }
     if (keyword == "mtllib") {
@@ -213,12 +209,19 @@ class PieceParser {
     return resolve(vn, kObjNormals, c);
   }
 
-  bool face(ObjWords& words) {
+  // The corners of an f, l or p element into p_.corners; false at a bad one.
+  bool corners(ObjWords& words, size_t& n) {
     size_t first = p_.corners.size();
     for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
       if (!corner(w)) return false;
     }
-    size_t n = p_.corners.size() - first;
+    n = p_.corners.size() - first;
+    return true;
+  }
+
+  bool face(ObjWords& words) {
+    size_t n = 0;
+    if (!corners(words, n)) return false;
     if (n < 3) return error("face with fewer than 3 vertices");
     p_.face_sizes.push_back(uint32_t(n));
     p_.triangles += n - 2;
@@ -228,11 +231,8 @@ class PieceParser {
   // "l v1 v2 ..." (a polyline) or "p v1 v2 ...": corners as a face's (a uv or normal is read and
   // not used), kept among the faces in file order.
   bool line_or_points(ObjWords& words, bool points) {
-    size_t first = p_.corners.size();
-    for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
-      if (!corner(w)) return false;
-    }
-    size_t n = p_.corners.size() - first;
+    size_t n = 0;
+    if (!corners(words, n)) return false;
     if (points && n < 1) return error("points (p) without a vertex");
     if (!points && n < 2) return error("line (l) with fewer than 2 vertices");
     p_.others.push_back({p_.face_sizes.size(), points});

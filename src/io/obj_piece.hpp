@@ -118,6 +118,13 @@ class ObjWords {
     return {start, size_t(at_ - start)};
   }
 
+  // The words left, one space apart (a name that may hold spaces: usemtl's, newmtl's).
+  std::string joined() {
+    std::string out(next());
+    for (std::string_view w = next(); !w.empty(); w = next()) out.append(" ").append(w);
+    return out;
+  }
+
  private:
   static bool is_space(char c) {
     return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
