@@ -10,11 +10,10 @@ namespace {
 
 void define_output_flags(CLI::App& app, RawArgs& a) {
   app.add_option("MODEL", a.models,
-                 "Model files (Wavefront OBJ with the MTL files it names, PLY or STL, told by "
-                 "their contents) or "
-                 "folders of them; "
-                 "several are drawn together as one scene, each with its own materials. Without "
-                 "MODEL, the built-in demo scene")
+                 "Model files (Wavefront OBJ with the MTL files it names, glTF 2.0 as .gltf or "
+                 ".glb, PLY or STL, told by their contents) or folders of them; several are drawn "
+                 "together as one scene, each with its own materials. Without MODEL, the built-in "
+                 "demo scene")
       ->type_name("MODEL...");
   app.add_option("-o,--out", a.output,
                  "Output image, .png, .jpg or .tga, or - for PNG on the standard output (default "
