@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <type_traits>
 #include <utility>
@@ -76,7 +77,9 @@ Result<ViewScene> load_view_scene(const std::vector<std::string>& models, float 
 
 void define_view_flags(CLI::App& app, ViewArgs& a) {
   RawArgs& r = a.render;
-  app.add_option("MODEL", a.models, "Wavefront OBJ files shown together; none: the demo scene");
+  app.add_option("MODEL", a.models,
+                 "Model files (OBJ, glTF 2.0, PLY or STL) or folders of them, shown together as "
+                 "one scene; none: the demo scene");
   app.add_option("--size", r.size, "Initial window size (default 1280x720)")->type_name("WxH");
   app.add_option("--shader", r.shader,
                  "flat, gouraud, texture, phong, normals, depth, wireframe or pbr (default phong; "
@@ -131,7 +134,8 @@ namespace {
   X(Quit) X(PollEvent) X(Init) X(GetError) X(DestroyTexture) X(Delay)                      \
   X(UnlockTexture) X(SetWindowTitle) X(SetTextureBlendMode) X(RenderPresent) X(RenderCopy) \
   X(RenderClear) X(LockTexture) X(GetWindowSize) X(GetRendererOutputSize) X(DestroyWindow) \
-  X(DestroyRenderer) X(CreateWindow) X(CreateTexture) X(CreateRenderer)
+  X(DestroyRenderer) X(CreateWindow) X(CreateTexture) X(CreateRenderer)                   \
+  X(GetCurrentVideoDriver)
 // clang-format on
 
 struct SdlApi {
@@ -544,6 +548,24 @@ class Viewer {
   std::chrono::steady_clock::time_point last_input_ = std::chrono::steady_clock::now();
 };
 
+// Whether the environment variable `name` is set to something (an empty value counts as unset).
+bool env_set(const char* name) {
+  const char* value = std::getenv(name);
+  return value != nullptr && *value != '\0';
+}
+
+const char* env_or_empty(const char* name) {
+  const char* value = std::getenv(name);
+  return value != nullptr ? value : "";
+}
+
+// SDL's video drivers that draw to no screen: "offscreen" (EGL without a surface) and "dummy".
+bool invisible_driver(const char* driver) {
+  if (driver == nullptr) return true;
+  const std::string_view name(driver);
+  return name == "offscreen" || name == "dummy";
+}
+
 // SDL_Init and SDL_Quit around the viewer's lifetime.
 struct SdlVideo {
   bool ok = sdl().Init(SDL_INIT_VIDEO) == 0;
@@ -568,9 +590,10 @@ int view_command(const ViewArgs& args, void (*report)(std::string message)) {
     return kExitUsage;
   }
   // Without a display SDL falls back to its offscreen driver, where the viewer would run unseen
-  // until killed; SDL_VIDEODRIVER still picks any driver on purpose (kmsdrm on a console).
-  if (!std::getenv("DISPLAY") && !std::getenv("WAYLAND_DISPLAY") &&
-      !std::getenv("SDL_VIDEODRIVER")) {
+  // until killed; SDL_VIDEODRIVER still picks any driver on purpose (kmsdrm on a console). An
+  // empty variable counts as unset (`DISPLAY= softrast view`), as X11 and SDL take it.
+  const bool driver_chosen = env_set("SDL_VIDEODRIVER");
+  if (!env_set("DISPLAY") && !env_set("WAYLAND_DISPLAY") && !driver_chosen) {
     report("no display to open a window on (DISPLAY and WAYLAND_DISPLAY are not set)");
     return kExitRuntime;
   }
@@ -592,6 +615,13 @@ int view_command(const ViewArgs& args, void (*report)(std::string message)) {
   SdlVideo video;
   if (!video.ok) {
     report(std::string("cannot start SDL's video (is there a display?): ") + sdl().GetError());
+    return kExitRuntime;
+  }
+  // A display named but not reachable (no X server at DISPLAY, no Wayland socket): SDL moves on
+  // to a driver that shows nothing, and the window would never appear.
+  if (!driver_chosen && invisible_driver(sdl().GetCurrentVideoDriver())) {
+    report(std::string("no display to open a window on (none answers at DISPLAY=") +
+           env_or_empty("DISPLAY") + ", WAYLAND_DISPLAY=" + env_or_empty("WAYLAND_DISPLAY") + ")");
     return kExitRuntime;
   }
   Viewer viewer(checked, std::move(*spec), std::move(*scene));
