@@ -7,7 +7,8 @@ medians) for each thread count: softrast --threads N beside llvmpipe with LP_NUM
 usage: compare_scenes.py [--scenes DIR] [--models DIR] [--build DIR] [--out DIR] [--runs N]
                          [--threads 1,2] [--only NAME[,NAME...]] [--all] [--extra "FLAGS"]
 By default it runs the rows of the speed issue's table (each with its target ratio); --all adds
-the other SCENES.md cases (flat shading, textured spheres); --extra adds flags that both
+the other SCENES.md cases (flat shading, textured spheres), quad_grid with mipmaps and the other
+real model of ../shared/models (african_head, texture and phong); --extra adds flags that both
 renderers take to every run (e.g. --extra "--msaa 4").
 Build first with: cmake --preset release -DSOFTRAST_BUILD_REFERENCE=ON && cmake --build --preset
 release. Scenes: python3 ../shared/bench/gen_scenes.py DIR (the default DIR is /tmp/scenes).
@@ -32,10 +33,15 @@ CAMERAS = {
     # A real textured model (../shared/models), as the speed issue measures it.
     "diablo3_pose": "--eye 0,0,3 --target 0,0,0 --up 0,1,0 --fov 45 --near 0.1 --far 100 "
                     "--cull back --frames 40",
+    # The other real model of ../shared/models, with the same camera (--all only).
+    "african_head": "--eye 0,0,3 --target 0,0,0 --up 0,1,0 --fov 45 --near 0.1 --far 100 "
+                    "--cull back --frames 40",
 }
 # Where each scene's files are: the generated scenes, or the shared models.
 MODEL_FILES = {"diablo3_pose": ("diablo3_pose/diablo3_pose.obj",
-                                "diablo3_pose/diablo3_pose_diffuse.tga")}
+                                "diablo3_pose/diablo3_pose_diffuse.tga"),
+               "african_head": ("african_head/african_head.obj",
+                                "african_head/african_head_diffuse.tga")}
 # Scenes that are another scene's file drawn with other flags.
 SCENE_FILE = {"quad_grid_trilinear": "quad_grid"}
 # The speed issue's table: (scene, shader, textured) -> target llvmpipe/softrast ratio.
@@ -54,6 +60,7 @@ CASES = [
     ("overdraw", "texture", True), ("overdraw", "phong", True),
     ("quad_grid", "texture", True), ("quad_grid", "phong", True),
     ("diablo3_pose", "phong", True), ("quad_grid_trilinear", "texture", True),
+    ("african_head", "texture", True), ("african_head", "phong", True),
 ]
 # samples_passed that SCENES.md states.
 EXPECTED_SAMPLES = {"overdraw": 106166512, "quad_grid": 2073600,
