@@ -625,6 +625,76 @@ TEST(SimdShader, DiscardingWideShaderEqualsItsScalarTwinAtEveryLevel) {
   }
 }
 
+// The fragment stage's guard on 1/w: where |1/w| < 1e-30 (zero included) a pixel divides as if it
+// were 1e-30 (shade_quad's rule). The pipeline's setup keeps 1/w planes far from that, so the
+// block functions are called here with planes made for it: 1/w of -1.5e-30, -0.5e-30, 0.5e-30
+// and 1.5e-30 across each row of the block, so that the middle two columns are guarded, and a
+// varying whose values come out -0.2, 0.3, 0.3 and 0.2 (the guarded ones would differ with any
+// other guard). Whole blocks and blocks of two triangles, at every level, against the scalar
+// stage bit for bit.
+struct GuardWide {
+  static constexpr int kVaryings = 1;
+  bool reads_derivatives() const { return false; }
+  template <int N>
+  void shade(Fragments<N>& f) const {
+    using F = simd::Float<N>;
+    f.color = {f.varying(0) + F(0.5f), F(0.25f), F(0.5f), F(1.0f)};
+  }
+};
+struct GuardScalar {
+  static constexpr int kVaryings = 1;
+  bool fragment(FragmentInput& in, glm::vec4& out) const {
+    out = {in.varyings[0] + 0.5f, 0.25f, 0.5f, 1.0f};
+    return true;
+  }
+};
+
+TEST(SimdShader, TinyInverseWIsGuardedAsTheScalarStageDoesAtEveryLevel) {
+  SimdLevelGuard guard;
+  detail::Interpolants in;
+  in.z = {0.5, 0.0, 0.0};
+  in.inv_w = {-2.0e-30f, 1.0e-30f, 0.0f};  // at pixel centres x + 0.5 of the block at x = 0
+  in.num_varyings = 1;
+  in.var[0] = {3.0e-31f, 0.0f, 0.0f};
+  detail::Interpolants other = in;  // the second triangle of a shared block: the same planes
+  RenderState state;
+  Framebuffer want(4, 4);
+  want.prepare_tile(0, 0);  // the block functions write the tile's storage: no clear pending
+  const detail::ShadeTarget want_target{&want, &state, false};
+  GuardScalar scalar;
+  detail::shade_block<GuardScalar>(&scalar, want_target, in, 0, 0, 0xffffu);
+  // The guard acted: columns 1 and 2 are 0.3 + 0.5, columns 0 and 3 are -0.2 + 0.5 and 0.2 + 0.5.
+  const int red[4] = {int(want.color_at(0, 0) & 0xffu), int(want.color_at(1, 0) & 0xffu),
+                      int(want.color_at(2, 0) & 0xffu), int(want.color_at(3, 0) & 0xffu)};
+  EXPECT_NEAR(red[0], 77, 1);
+  EXPECT_NEAR(red[1], 204, 1);
+  EXPECT_EQ(red[1], red[2]);
+  EXPECT_NEAR(red[3], 179, 1);
+  GuardWide wide;
+  for (SimdLevel level : levels_of_this_cpu()) {
+    Framebuffer whole(4, 4), shared(4, 4);
+    whole.prepare_tile(0, 0);
+    shared.prepare_tile(0, 0);
+    const detail::ShadeTarget whole_target{&whole, &state, false};
+    const detail::ShadeTarget shared_target{&shared, &state, false};
+    detail::wide_shade_block<GuardWide>(level)(&wide, whole_target, in, 0, 0, 0xffffu);
+    detail::MixedBlock block;
+    block.winner[0] = &in;
+    block.mask[0] = 0x0f0fu;
+    block.winner[1] = &other;
+    block.mask[1] = 0xf0f0u;
+    block.count = 2;
+    detail::wide_shade_mixed<GuardWide>(level)(&wide, shared_target, block, 0, 0);
+    for (int y = 0; y < 4; ++y) {
+      for (int x = 0; x < 4; ++x) {
+        EXPECT_EQ(whole.color_at(x, y), want.color_at(x, y)) << simd_level_name(level) << " whole";
+        EXPECT_EQ(shared.color_at(x, y), want.color_at(x, y))
+            << simd_level_name(level) << " shared";
+      }
+    }
+  }
+}
+
 // The same textured quad through a custom wide shader that writes packed bytes
 // (Fragments::set_rgba8 of sample_rgba8) and one that writes f.color = sample(...): opaque, the
 // same image at every level; blended, the packed one blends from byte / 255, as its twin that

@@ -277,6 +277,19 @@ SOFTRAST_SIMD_INLINE simd::Int<N> blend(BlendMode mode, const simd::Vec4<N>& col
   std::abort();
 }
 
+// w = 1 / inv_w, with shade_quad's guard: an |inv_w| below 1e-30 (zero included; NaN is not:
+// the scalar test's -1e-30 < inv_w < 1e-30 in one comparison) divides as 1e-30 would. The
+// division does not wait for the test: lanes the guard moves take the quotient 1 / 1e-30 (the
+// same IEEE division, done once by the compiler), chosen after it. That takes the comparison off
+// the block's longest chain, which a textured block's time follows (its texel addresses wait for
+// w): quad_grid texture 4 % faster.
+template <int N>
+SOFTRAST_SIMD_INLINE simd::Float<N> guarded_w(const simd::Float<N>& inv_w) {
+  using F = simd::Float<N>;
+  constexpr float kGuarded = 1.0f / 1.0e-30f;
+  return simd::select(simd::abs(inv_w) < F(1.0e-30f), F(kGuarded), F(1.0f) / inv_w);
+}
+
 template <class S>
 concept CheapToShade = requires {
   requires S::kCheapToShade;
@@ -358,10 +371,7 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
   // keeps derivatives finite (clamping 1/w to a tiny positive value made them huge and sent
   // trilinear lookups to the last mip level). Only a 1/w too close to 0 to divide by is moved.
   F inv_w = eval_plane<N>(in.inv_w, dx, dy);
-  // |inv_w| < 1e-30 is the scalar test's -1e-30 < inv_w < 1e-30 (NaN fails both), in one
-  // comparison.
-  inv_w = simd::select(simd::abs(inv_w) < F(1.0e-30f), F(1.0e-30f), inv_w);
-  F w = F(1.0f) / inv_w;
+  F w = guarded_w<N>(inv_w);
   F var[kN];
   for (int i = 0; i < S::kVaryings; ++i) var[i] = eval_plane<N>(in.var[i], dx, dy) * w;
   f.varyings = var;
@@ -573,10 +583,7 @@ SOFTRAST_SIMD_INLINE void shade_mixed_with(const S& shader, const ShadeTarget& t
   f.depth = z;
   // eval_plane's operations, with per-lane coefficients.
   F inv_w = a0 + dadx * dx + dady * dy;
-  // |inv_w| < 1e-30 is the scalar test's -1e-30 < inv_w < 1e-30 (NaN fails both), in one
-  // comparison.
-  inv_w = simd::select(simd::abs(inv_w) < F(1.0e-30f), F(1.0e-30f), inv_w);
-  F w = F(1.0f) / inv_w;
+  F w = guarded_w<N>(inv_w);
   F var[kN];
   for (int i = 0; i < S::kVaryings; ++i) {
     var[i] = (coef.var(i, 0) + coef.var(i, 1) * dx + coef.var(i, 2) * dy) * w;
