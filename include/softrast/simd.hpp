@@ -82,6 +82,7 @@ SOFTRAST_AVX512 void broadcast(float s, F16& r);
 SOFTRAST_AVX512 void broadcast(int32_t s, I16& r);
 SOFTRAST_AVX512 void store_lanes(uint32_t bits, const F16& v, float* to);
 SOFTRAST_AVX512 void store_lanes(uint32_t bits, const I16& v, int32_t* to);
+SOFTRAST_AVX512 void lanes_of(uint32_t bits, I16& r);
 // AVX2's broadcasts, one VBROADCASTSS or VPBROADCASTD (the shuffle of lane 0 below is a move into
 // a zeroed register, a move to clear the upper lanes again and then the broadcast).
 using F8 = float __attribute__((vector_size(32)));
@@ -441,6 +442,10 @@ SOFTRAST_AVX512 void broadcast(int32_t s, I16& r) {
 }
 SOFTRAST_AVX512 void blend(const I16& mask, const I16& a, const I16& b, I16& r) {
   r = I16(_mm512_mask_blend_epi32(_mm512_movepi32_mask(__m512i(mask)), __m512i(b), __m512i(a)));
+}
+// Lane k all ones where bit k of `bits` is set, else zero: a mask register made a vector.
+SOFTRAST_AVX512 void lanes_of(uint32_t bits, I16& r) {
+  r = I16(_mm512_movm_epi32(__mmask16(bits)));
 }
 SOFTRAST_AVX512 void store_lanes(uint32_t bits, const F16& v, float* to) {
   _mm512_mask_storeu_ps(to, __mmask16(bits), __m512(v));
@@ -914,10 +919,17 @@ alignas(64) inline constexpr int32_t kLaneQuadTopLeft[kLanes] = {0, 0, 2,  2,  0
 
 // The lane mask of a 16-bit block mask. Masks are read by their sign bit everywhere (select,
 // bits, and/or), so lane i only needs bit i of `mask` moved to bit 31: a multiplication by
-// 2^(31 - i), with no comparison (GCC 12 splits some AVX-512 comparisons into lanes).
+// 2^(31 - i), with no comparison (GCC 12 splits some AVX-512 comparisons into lanes). At AVX-512
+// the mask goes into a mask register and out as whole lanes (two instructions, where the
+// multiplication's latency is ten cycles).
 template <int N>
 SOFTRAST_SIMD_INLINE Int<N> lanes_of(uint32_t mask) {
   using U = typename Native<N>::U;
+  if constexpr (N == 16) {
+    Int<N> lanes;
+    isa::lanes_of(mask, lanes.p[0]);
+    return lanes;
+  }
   Int<N> m = Int<N>(int32_t(mask)), out;
   for (int k = 0; k < Int<N>::kParts; ++k) {
     U scale = U(*reinterpret_cast<const typename Native<N>::IU*>(kLaneToSign + k * N));
