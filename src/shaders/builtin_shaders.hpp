@@ -148,6 +148,15 @@ struct TextureShader {
   SampledTexture map;  // the texture and its sampler
   float alpha = 1.0f;
   bool srgb = false;  // encode the output (the linear workflow)
+  // Opaque pixels take the texel as it is (alpha 1, nothing encoded, no mip levels): decided
+  // once for the draw (packed_texel()), not per block, so the fields are set here.
+  bool packed = false;
+  explicit TextureShader(MeshInputs inputs = {}, SampledTexture m = {}, float a = 1.0f,
+                         bool encode = false)
+      : in(inputs), map(m), alpha(a), srgb(encode), packed(packed_texel()) {}
+  bool packed_texel() const {
+    return alpha == 1.0f && !srgb && map.sampler().filter != Filter::kTrilinear;
+  }
   bool reads_derivatives() const { return map.sampler().filter == Filter::kTrilinear; }
   glm::vec4 vertex(uint32_t i, float* v) const {
     glm::vec2 uv = in.uv(i);
@@ -158,7 +167,7 @@ struct TextureShader {
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     // Opaque, alpha 1, nothing encoded, no mip levels: the texel as it is, packed by the sampler
     // (sample_rgba8: the same bytes).
-    if (f.opaque && alpha == 1.0f && !srgb && map.sampler().filter != Filter::kTrilinear) {
+    if (f.opaque && packed) {
       f.set_rgba8(sample_rgba8<N>(map, f.vec2(0)));
       return;
     }
