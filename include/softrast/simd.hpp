@@ -83,6 +83,9 @@ SOFTRAST_AVX512 void broadcast(int32_t s, I16& r);
 SOFTRAST_AVX512 void store_lanes(uint32_t bits, const F16& v, float* to);
 SOFTRAST_AVX512 void store_lanes(uint32_t bits, const I16& v, int32_t* to);
 SOFTRAST_AVX512 void lanes_of(uint32_t bits, I16& r);
+// r[i] = bit i of `bits` ? b : a, for 16 doubles.
+using D16 = double __attribute__((vector_size(128)));
+SOFTRAST_AVX512 void pick(uint32_t bits, const double& a, const double& b, D16& r);
 // AVX2's broadcasts, one VBROADCASTSS or VPBROADCASTD (the shuffle of lane 0 below is a move into
 // a zeroed register, a move to clear the upper lanes again and then the broadcast).
 using F8 = float __attribute__((vector_size(32)));
@@ -446,6 +449,13 @@ SOFTRAST_AVX512 void blend(const I16& mask, const I16& a, const I16& b, I16& r) 
 // Lane k all ones where bit k of `bits` is set, else zero: a mask register made a vector.
 SOFTRAST_AVX512 void lanes_of(uint32_t bits, I16& r) {
   r = I16(_mm512_movm_epi32(__mmask16(bits)));
+}
+SOFTRAST_AVX512 void pick(uint32_t bits, const double& a, const double& b, D16& r) {
+  using D8 = double __attribute__((vector_size(64)));
+  const __m512d low = _mm512_set1_pd(a);
+  const D8 first(_mm512_mask_blend_pd(__mmask8(bits), low, _mm512_set1_pd(b)));
+  const D8 second(_mm512_mask_blend_pd(__mmask8(bits >> 8), low, _mm512_set1_pd(b)));
+  r = __builtin_shufflevector(first, second, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
 }
 SOFTRAST_AVX512 void store_lanes(uint32_t bits, const F16& v, float* to) {
   _mm512_mask_storeu_ps(to, __mmask16(bits), __m512(v));
