@@ -934,16 +934,16 @@ alignas(64) inline constexpr int32_t kLaneQuadTopLeft[kLanes] = {0, 0, 2,  2,  0
 // multiplication's latency is ten cycles).
 template <int N>
 SOFTRAST_SIMD_INLINE Int<N> lanes_of(uint32_t mask) {
-  using U = typename Native<N>::U;
+  Int<N> out;
   if constexpr (N == 16) {
-    Int<N> lanes;
-    isa::lanes_of(mask, lanes.p[0]);
-    return lanes;
-  }
-  Int<N> m = Int<N>(int32_t(mask)), out;
-  for (int k = 0; k < Int<N>::kParts; ++k) {
-    U scale = U(*reinterpret_cast<const typename Native<N>::IU*>(kLaneToSign + k * N));
-    out.p[k] = typename Native<N>::I(U(m.p[k]) * scale);
+    isa::lanes_of(mask, out.p[0]);
+  } else {
+    using U = typename Native<N>::U;
+    Int<N> m = Int<N>(int32_t(mask));
+    for (int k = 0; k < Int<N>::kParts; ++k) {
+      U scale = U(*reinterpret_cast<const typename Native<N>::IU*>(kLaneToSign + k * N));
+      out.p[k] = typename Native<N>::I(U(m.p[k]) * scale);
+    }
   }
   return out;
 }

@@ -211,10 +211,9 @@ namespace avx512 {
 // fraction of -0 comes out +0 here and -0 there; both give the weight 0.) The range test runs
 // beside the rounding and masks its results, so the texel addresses, which the block's time
 // follows, do not wait for it (quad_grid texture 2 % faster than masking x first). Here and
-// below, the
-// masked forms of the intrinsics and GCC's vector operators: the unmasked intrinsics of GCC 12's
-// header leave a variable uninitialised, which -Wmaybe-uninitialized reports at every inlining
-// site (GCC bug 105593, fixed in GCC 13).
+// below, the masked forms of the intrinsics and GCC's vector operators: the unmasked intrinsics
+// of GCC 12's header leave a variable uninitialised, which -Wmaybe-uninitialized reports at every
+// inlining site (GCC bug 105593, fixed in GCC 13).
 SOFTRAST_AVX512_SAMPLER __m512i floor16(__m512 x, __m512& fraction) {
   __mmask16 ok = _mm512_cmp_ps_mask(x, _mm512_set1_ps(-1.0e9f), _CMP_GT_OQ) &
                  _mm512_cmp_ps_mask(x, _mm512_set1_ps(1.0e9f), _CMP_LT_OQ);
