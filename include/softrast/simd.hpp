@@ -658,8 +658,8 @@ SOFTRAST_SIMD_INLINE void through_memory(int32_t (&at)[Lanes]) {
   }
 }
 
-// The 64-bit pairs base[index[i]], base[index[i] + 1] of every lane, in lane order: a holds
-// lanes 0 to N/2 - 1, c the rest (gather_pair below sorts them into lo and hi).
+// The 64-bit pairs base[index[i]], base[index[i] + 1] of every lane, in lane order: at 8 lanes
+// a holds lanes 0 to 3, c the rest (gather_pair below sorts them into lo and hi).
 [[gnu::target("avx2")]] inline void pairs_instruction(const int32_t* base,
                                                       const Native<8>::I& index, __m256i& a,
                                                       __m256i& c) {
@@ -676,17 +676,25 @@ SOFTRAST_SIMD_INLINE void through_memory(int32_t (&at)[Lanes]) {
   a = join(load_pairs2(base, at), load_pairs2(base, at + 2));
   c = join(load_pairs2(base, at + 4), load_pairs2(base, at + 6));
 }
+// At 16 lanes both forms give the pairs already sorted: lo[i] = base[index[i]], hi[i] =
+// base[index[i] + 1] (gather_pair takes them as they are, and the start-up timing times what
+// gather_pair runs).
 [[gnu::target("avx512f")]] inline void pairs_instruction(const int32_t* base,
-                                                         const Native<16>::I& index, __m512i& a,
-                                                         __m512i& c) {
+                                                         const Native<16>::I& index, __m512i& lo,
+                                                         __m512i& hi) {
   // The masked form with a zero source, and the index's halves by a vector shuffle: GCC 12's
   // header leaves the unmasked forms' sources uninitialised (a -Wmaybe-uninitialized warning
   // wherever this is inlined; GCC bug 105593).
   const __m512i zero = _mm512_setzero_si512();
   const Native<8>::I low = __builtin_shufflevector(index, index, 0, 1, 2, 3, 4, 5, 6, 7);
   const Native<8>::I high = __builtin_shufflevector(index, index, 8, 9, 10, 11, 12, 13, 14, 15);
-  a = _mm512_mask_i32gather_epi64(zero, 0xff, __m256i(low), base, 4);
-  c = _mm512_mask_i32gather_epi64(zero, 0xff, __m256i(high), base, 4);
+  // a = lanes 0 to 7's pairs, c = lanes 8 to 15's (each pair two 32-bit elements, l then h)
+  const __m512i a = _mm512_mask_i32gather_epi64(zero, 0xff, __m256i(low), base, 4);
+  const __m512i c = _mm512_mask_i32gather_epi64(zero, 0xff, __m256i(high), base, 4);
+  const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+  const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
+  lo = _mm512_permutex2var_epi32(a, even, c);
+  hi = _mm512_permutex2var_epi32(a, odd, c);
 }
 // Asks the cache for base[at[lane] + ahead] for lanes 0, 4, 8 and 12 (addresses formed as
 // integers: they may lie past the table, which a prefetch never faults on).
@@ -697,15 +705,26 @@ inline void prefetch_every_fourth(const int32_t* base, const int32_t* at, int ah
     _mm_prefetch(reinterpret_cast<const char*>(start + element * sizeof(int32_t)), _MM_HINT_T0);
   }
 }
+// The pairs sorted into lo and hi four lanes at a time, as they arrive (two unpacks), and then
+// joined: a shorter way from the loads to lo and hi than joining the pairs whole and sorting them
+// by two-source permutes (the sampler's texels wait on it; quad_grid phong + texture 1 % faster).
 [[gnu::target("avx512f")]] inline void pairs_loads(const int32_t* base, const Native<16>::I& index,
-                                                   __m512i& a, __m512i& c, int ahead = 0) {
+                                                   __m512i& lo, __m512i& hi, int ahead = 0) {
   alignas(64) int32_t at[16];
   store_halves(at, index);
   if (ahead != 0) prefetch_every_fourth(base, at, ahead);
-  a = join(join(load_pairs2(base, at), load_pairs2(base, at + 2)),
-           join(load_pairs2(base, at + 4), load_pairs2(base, at + 6)));
-  c = join(join(load_pairs2(base, at + 8), load_pairs2(base, at + 10)),
-           join(load_pairs2(base, at + 12), load_pairs2(base, at + 14)));
+  auto pair = [&](int l) {
+    return _mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + at[l]));
+  };
+  __m128i low4[4], high4[4];
+  for (int g = 0; g < 4; ++g) {
+    const __m128i p01 = _mm_unpacklo_epi32(pair(4 * g), pair(4 * g + 1));      // l0 l1 h0 h1
+    const __m128i p23 = _mm_unpacklo_epi32(pair(4 * g + 2), pair(4 * g + 3));  // l2 l3 h2 h3
+    low4[g] = _mm_unpacklo_epi64(p01, p23);
+    high4[g] = _mm_unpackhi_epi64(p01, p23);
+  }
+  lo = join(join(low4[0], low4[1]), join(low4[2], low4[3]));
+  hi = join(join(high4[0], high4[1]), join(high4[2], high4[3]));
 }
 
 // r[i] = table[index[i]] for a table of 16 floats, indices in [0, 16): a permute, no memory
@@ -798,35 +817,14 @@ inline void gather_pair(const int32_t* base, const Native<4>::I& index, Native<4
                                                    Native<16>::I& lo, Native<16>::I& hi,
                                                    IndexRoute = IndexRoute::kMemory,
                                                    int ahead = 0) {
+  __m512i l, h;
   if (loads_for_gathers<16>()) {
-    // The pairs sorted into lo and hi four lanes at a time, as they arrive (two unpacks), and
-    // then joined: a shorter way from the loads to lo and hi than joining the pairs whole and
-    // sorting them by two-source permutes (the sampler's texels wait on it; quad_grid phong +
-    // texture 1 % faster).
-    alignas(64) int32_t at[16];
-    store_halves(at, index);
-    if (ahead != 0) prefetch_every_fourth(base, at, ahead);
-    auto pair = [&](int l) {
-      return _mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + at[l]));
-    };
-    __m128i low4[4], high4[4];
-    for (int g = 0; g < 4; ++g) {
-      const __m128i p01 = _mm_unpacklo_epi32(pair(4 * g), pair(4 * g + 1));      // l0 l1 h0 h1
-      const __m128i p23 = _mm_unpacklo_epi32(pair(4 * g + 2), pair(4 * g + 3));  // l2 l3 h2 h3
-      low4[g] = _mm_unpacklo_epi64(p01, p23);
-      high4[g] = _mm_unpackhi_epi64(p01, p23);
-    }
-    lo = Native<16>::I(join(join(low4[0], low4[1]), join(low4[2], low4[3])));
-    hi = Native<16>::I(join(join(high4[0], high4[1]), join(high4[2], high4[3])));
-    return;
+    pairs_loads(base, index, l, h, ahead);
+  } else {
+    pairs_instruction(base, index, l, h);
   }
-  // a = lanes 0 to 7's pairs, c = lanes 8 to 15's (each pair two 32-bit elements, l then h)
-  __m512i a, c;
-  pairs_instruction(base, index, a, c);
-  const __m512i even = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
-  const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
-  lo = Native<16>::I(_mm512_permutex2var_epi32(a, even, c));
-  hi = Native<16>::I(_mm512_permutex2var_epi32(a, odd, c));
+  lo = Native<16>::I(l);
+  hi = Native<16>::I(h);
 }
 
 }  // namespace isa

@@ -550,11 +550,8 @@ struct MixedPair {
       simd::isa::pick(bits, first.z.dadx, second.z.dadx, dadx);
       simd::isa::pick(bits, first.z.dady, second.z.dady, dady);
       const D x = __builtin_convertvector(dx.p[0], D), y = __builtin_convertvector(dy.p[0], D);
-      F own;
-      own.p[0] = __builtin_convertvector((a0 + dadx * x) + dady * y, typename simd::Native<N>::F);
-      // Covered lanes take their triangle's depth, clamped; the others keep `z` (the stored depth).
-      z = simd::select(simd::lanes_of<N>(block.mask[0] | bits), simd::clamp(own, F(0.0f), F(1.0f)),
-                       z);
+      z.p[0] = __builtin_convertvector((a0 + dadx * x) + dady * y, typename simd::Native<N>::F);
+      z = simd::clamp(z, F(0.0f), F(1.0f));  // lanes no triangle covers: the first's, never used
     } else {
       mixed_depth_by_triangle<N>(block, px, py, z);
     }
