@@ -493,5 +493,34 @@ TEST(TextureRules, TranslucentCountsAreasNotStrayTexels) {
   EXPECT_TRUE(copy.translucent());
 }
 
+// The AVX-512 sampler's row pairs: element (i, j) holds texel (i, j) and the one above it, each
+// row clamped to the texture, for j from -1 to the last row; built once, for copies too; none for
+// an empty texture or above kMaxRowPairTexels texels.
+TEST(TextureRules, RowPairsHoldEachTexelAndTheOneAboveClampedAtBothEdges) {
+  EXPECT_EQ(Texture().row_pairs(), nullptr);
+  const Image image = noise_image(5, 3, 17);
+  const Texture t = Texture::from_image(image);
+  auto stored = [&](int i, int j) {  // texel (i, j) as the image holds it, red in the low byte
+    const uint8_t* p = image.pixel(i, image.height - 1 - j);
+    return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+  };
+  const Texture copy = t;
+  for (const Texture* texture : {&t, &copy}) {
+    const uint64_t* pairs = texture->row_pairs();
+    ASSERT_NE(pairs, nullptr);
+    EXPECT_EQ(texture->row_pairs(), pairs);  // kept
+    for (int j = -1; j < 3; ++j) {
+      for (int i = 0; i < 5; ++i) {
+        const uint64_t want = stored(i, std::max(j, 0)) | uint64_t(stored(i, std::min(j + 1, 2)))
+                                                              << 32;
+        EXPECT_EQ(pairs[j * 5 + i], want) << "pair " << i << "," << j;
+      }
+    }
+  }
+  EXPECT_NE(copy.row_pairs(), t.row_pairs());  // the copy's own
+  EXPECT_EQ(Texture::from_image(Image(2049, 2048)).row_pairs(), nullptr);
+  EXPECT_NE(Texture::from_image(Image(2048, 2048)).row_pairs(), nullptr);
+}
+
 }  // namespace
 }  // namespace softrast

@@ -16,6 +16,7 @@
 #include <glm/vec4.hpp>
 
 #include "softrast/image.hpp"
+#include "softrast/simd_level.hpp"
 
 namespace softrast {
 
@@ -154,6 +155,15 @@ class Texture {
   // first use and kept: the built-in shaders ask it in every frame.
   bool translucent() const;
 
+  // The base level's texels in vertical pairs, for the AVX-512 sampler's bilinear loads: element
+  // (i, j) is the 64-bit pair of texels (i, clamp(j)) and (i, clamp(j + 1)), rows clamped to the
+  // edge, for j from -1 (the returned pointer's row 0 is j = 0; row -1 lies before it). So one
+  // 128-bit load at (i, j) holds all four texels a bilinear sample of rows j and j + 1 and
+  // columns i and i + 1 reads. Built on first call (safe from several threads at once) and kept;
+  // null for an empty texture and above kMaxRowPairTexels texels (twice the base level's memory).
+  const uint64_t* row_pairs() const;
+  static constexpr size_t kMaxRowPairTexels = size_t(1) << 22;
+
   // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
   static int wrap(Wrap mode, int i, int size);
   // wrap() of `count` indices in place, index k within sizes[k] (out of line: the wide samplers'
@@ -221,6 +231,8 @@ class Texture {
     std::mutex mutex;
     std::atomic<bool> ready{false};
     std::atomic<int> translucent{-1};  // translucent(): -1 until computed
+    std::vector<uint64_t> pairs;       // row_pairs(): written once, under `mutex`
+    std::atomic<const uint64_t*> pairs_row0{nullptr};
   };
   void build_mips() const;
   bool compute_translucent() const;
@@ -249,6 +261,9 @@ struct BilinearPlan {
   bool repeat_u = false, repeat_v = false;  // else clamped to the edge
   int32_t row_width = 0;                    // texels per row
   int row_shift = -1;                       // log2(row_width) for a power of two, else -1
+  // Texture::row_pairs() where the sampler reads texels by loads (gather_mode kLoads) at AVX-512,
+  // else null (the gather instruction reads the rows as they are).
+  const int64_t* pairs = nullptr;
 
   static BilinearPlan of(const Texture& t, const Sampler& s) {
     BilinearPlan p;
@@ -266,6 +281,10 @@ struct BilinearPlan {
     p.repeat_v = s.wrap_v == Wrap::kRepeat;
     p.row_width = w;
     p.row_shift = pow2_u ? __builtin_ctz(unsigned(w)) : -1;
+    if (simd_level() == SimdLevel::kAvx512 &&
+        gather_mode(SimdLevel::kAvx512) == GatherMode::kLoads) {
+      p.pairs = reinterpret_cast<const int64_t*>(t.row_pairs());
+    }
     return p;
   }
 };

@@ -225,6 +225,25 @@ void Texture::wrap_lanes(Wrap mode, int32_t* indices, const int32_t* sizes, int 
   for (int k = 0; k < count; ++k) indices[k] = wrap(mode, indices[k], sizes[k]);
 }
 
+const uint64_t* Texture::row_pairs() const {
+  if (!mips_ || size_t(width_) * size_t(height_) > kMaxRowPairTexels) return nullptr;
+  if (const uint64_t* row0 = mips_->pairs_row0.load(std::memory_order_acquire)) return row0;
+  std::lock_guard<std::mutex> lock(mips_->mutex);
+  if (const uint64_t* row0 = mips_->pairs_row0.load(std::memory_order_relaxed)) return row0;
+  const size_t w = size_t(width_);
+  const auto* texels = reinterpret_cast<const uint32_t*>(texels_.data());
+  std::vector<uint64_t>& pairs = mips_->pairs;
+  pairs.resize(w * (size_t(height_) + 1));
+  for (int j = -1; j < height_; ++j) {
+    const uint32_t* lower = texels + size_t(std::max(j, 0)) * w;
+    const uint32_t* upper = texels + size_t(std::min(j + 1, height_ - 1)) * w;
+    uint64_t* out = pairs.data() + size_t(j + 1) * w;
+    for (size_t i = 0; i < w; ++i) out[i] = uint64_t(lower[i]) | uint64_t(upper[i]) << 32;
+  }
+  mips_->pairs_row0.store(pairs.data() + w, std::memory_order_release);
+  return pairs.data() + w;
+}
+
 bool Texture::translucent() const {
   if (!mips_) return false;  // empty: samples as opaque white
   int known = mips_->translucent.load(std::memory_order_relaxed);

@@ -244,6 +244,8 @@ SOFTRAST_AVX512_SAMPLER __m512i wrap_clamp_or_repeat16(bool repeat, __m512i i, i
 // 16 and 64; aiming at the next block's own texels (from the block's change across its row)
 // measured no faster than none.
 inline constexpr int kTexelsAhead = 32;
+// The same for the row pairs, in pairs (eight to a line): as many lines ahead.
+inline constexpr int kPairsAhead = 16;
 
 // The four texels of each lane from its rows' first texels and its two columns: one 64-bit load
 // per lane and row where no lane wraps between its columns (sample_level), else four gathers.
@@ -265,6 +267,43 @@ SOFTRAST_AVX512_SAMPLER void gather_bilinear16(
   simd::isa::gather(texels, row1 + i1, t1);
 }
 
+// The four texels of every lane from the row pairs (Texture::row_pairs), where each lane's
+// columns are neighbours: one 128-bit load per lane at its pair `at` holds b0, t0, b1 and t1, and
+// a 4x4 transpose within each 128-bit part sorts them into the four vectors (as the triangle
+// setup's load_quads: part c of vector m gathers lane 4c + m). Half the loads of two rows of
+// 64-bit pairs, and no sorting of the pairs after them.
+SOFTRAST_AVX512_SAMPLER void load_row_pairs16(const int64_t* pairs, const simd::Native<16>::I& at,
+                                              simd::Native<16>::I& b0, simd::Native<16>::I& b1,
+                                              simd::Native<16>::I& t0, simd::Native<16>::I& t1) {
+  alignas(64) int32_t lane[16];
+  _mm512_store_si512(lane, __m512i(at));
+  // (Addresses formed as integers: they may lie past the table, which a prefetch never faults on.)
+  const uintptr_t start = reinterpret_cast<uintptr_t>(pairs);
+  for (int l = 0; l < 16; l += 4) {
+    const uintptr_t ahead = uintptr_t(int64_t(lane[l]) + kPairsAhead) * sizeof(int64_t);
+    _mm_prefetch(reinterpret_cast<const char*>(start + ahead), _MM_HINT_T0);
+  }
+  auto quad = [&](int l) {
+    return _mm_loadu_si128(reinterpret_cast<const __m128i*>(pairs + lane[l]));
+  };
+  __m512i m[4];
+  for (int k = 0; k < 4; ++k) {
+    const __m256i low = _mm256_inserti128_si256(_mm256_castsi128_si256(quad(k)), quad(k + 4), 1);
+    const __m256i high =
+        _mm256_inserti128_si256(_mm256_castsi128_si256(quad(k + 8)), quad(k + 12), 1);
+    m[k] = _mm512_maskz_inserti64x4(__mmask8(0xff), _mm512_castsi256_si512(low), high, 1);
+  }
+  const __mmask16 all = 0xffff;
+  const __m512i a = _mm512_maskz_unpacklo_epi32(all, m[0], m[1]);
+  const __m512i b = _mm512_maskz_unpackhi_epi32(all, m[0], m[1]);
+  const __m512i c = _mm512_maskz_unpacklo_epi32(all, m[2], m[3]);
+  const __m512i d = _mm512_maskz_unpackhi_epi32(all, m[2], m[3]);
+  b0 = simd::Native<16>::I(_mm512_maskz_unpacklo_epi64(__mmask8(0xff), a, c));
+  t0 = simd::Native<16>::I(_mm512_maskz_unpackhi_epi64(__mmask8(0xff), a, c));
+  b1 = simd::Native<16>::I(_mm512_maskz_unpacklo_epi64(__mmask8(0xff), b, d));
+  t1 = simd::Native<16>::I(_mm512_maskz_unpackhi_epi64(__mmask8(0xff), b, d));
+}
+
 // The four texels (bilinear_texels) and the weights' fractions of 16 lanes in the common case
 // (BilinearPlan, texture.hpp). Everything by reference: a caller compiled for the baseline (a
 // test, say) that does not inline this would pass 64-byte vectors in memory where it expects
@@ -283,6 +322,27 @@ SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const BilinearPlan& p, const simd
   const __m512i one = _mm512_set1_epi32(1);
   V i0 = V(wrap_clamp_or_repeat16(p.repeat_u, x0, p.last_u));
   V i1 = V(wrap_clamp_or_repeat16(p.repeat_u, _mm512_add_epi32(x0, one), p.last_u));
+  fxl.p[0] = simd::Native<16>::F(fx);
+  fyl.p[0] = simd::Native<16>::F(fy);
+  if (p.pairs != nullptr) {
+    // The row pairs (Texture::row_pairs): the pair at row r holds rows clamp(r) and clamp(r + 1),
+    // for r from -1. Clamped, y0 itself within [-1, last] names both rows; repeated, y0 & last
+    // does unless it is the last row (whose upper row wraps to row 0: the gathers below).
+    V r = V(y0);
+    __mmask16 wraps = 0;
+    if (p.repeat_v) {
+      r &= p.last_v;
+      wraps = _mm512_cmpeq_epi32_mask(__m512i(r), _mm512_set1_epi32(p.last_v));
+    } else {
+      r = r < -1 ? V{} - 1 : r;
+      r = r > p.last_v ? V{} + p.last_v : r;
+    }
+    if ((_mm512_cmpneq_epi32_mask(__m512i(i1), __m512i(i0 + 1)) | wraps) == 0) {
+      const V at = (p.row_shift >= 0 ? r << p.row_shift : r * p.row_width) + i0;
+      load_row_pairs16(p.pairs, at, b0.p[0], b1.p[0], t0.p[0], t1.p[0]);
+      return;
+    }
+  }
   V j0 = V(wrap_clamp_or_repeat16(p.repeat_v, y0, p.last_v));
   V j1 = V(wrap_clamp_or_repeat16(p.repeat_v, _mm512_add_epi32(y0, one), p.last_v));
   V row0, row1;
@@ -294,8 +354,6 @@ SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const BilinearPlan& p, const simd
     row1 = j1 * p.row_width;
   }
   gather_bilinear16(p.texels, row0, row1, i0, i1, b0.p[0], b1.p[0], t0.p[0], t1.p[0], true);
-  fxl.p[0] = simd::Native<16>::F(fx);
-  fyl.p[0] = simd::Native<16>::F(fy);
 }
 
 #undef SOFTRAST_AVX512_SAMPLER
