@@ -101,25 +101,33 @@ INSTANTIATE_TEST_SUITE_P(AllShaders, SimdLevelGolden,
 // The wide sampler against Texture::sample, lane by lane, at one level (N lanes per vector).
 // Derivatives for the trilinear case: each lane's uv changes by (lane-dependent) amounts that
 // span magnification to far past the last level.
-glm::vec2 test_ddx(size_t i) {
+// Lod::kNear keeps every lane within 1.5 levels of the base instead (1 to 2.8 texels a pixel
+// along each axis), so that whole groups of lanes read levels with room for both of their columns
+// (the AVX-512 trilinear sampler's row pairs).
+enum class Lod { kWide, kNear };
+glm::vec2 test_ddx(size_t i, Lod lod = Lod::kWide, const Texture* t = nullptr) {
+  if (lod == Lod::kNear) return {std::exp2(float(i % 4) * 0.5f) / float(t->width()), 0.0f};
   return {std::ldexp(1.0f, int(i % 23) - 12) * 0.7f, std::ldexp(1.0f, int(i % 7) - 9)};
 }
-glm::vec2 test_ddy(size_t i) {
+glm::vec2 test_ddy(size_t i, Lod lod = Lod::kWide, const Texture* t = nullptr) {
+  if (lod == Lod::kNear) return {0.0f, std::exp2(float(i % 3) * 0.7f) / float(t->height())};
   return {-std::ldexp(1.0f, int(i % 5) - 10), std::ldexp(1.0f, int(i % 19) - 11) * 1.3f};
 }
 
 template <int N>
 void expect_sampler_matches_scalar(const Texture& texture, const Sampler& sampler,
-                                   const std::vector<glm::vec2>& uvs) {
+                                   const std::vector<glm::vec2>& uvs, Lod lod) {
+  auto ddx = [&](size_t i) { return test_ddx(i, lod, &texture); };
+  auto ddy = [&](size_t i) { return test_ddy(i, lod, &texture); };
   for (size_t first = 0; first + simd::kLanes <= uvs.size(); first += simd::kLanes) {
     simd::Vec2<N> uv, dx, dy;
     for (int i = 0; i < simd::kLanes; ++i) {
       uv.x.set_lane(i, uvs[first + i].x);
       uv.y.set_lane(i, uvs[first + i].y);
-      dx.x.set_lane(i, test_ddx(first + i).x);
-      dx.y.set_lane(i, test_ddx(first + i).y);
-      dy.x.set_lane(i, test_ddy(first + i).x);
-      dy.y.set_lane(i, test_ddy(first + i).y);
+      dx.x.set_lane(i, ddx(first + i).x);
+      dx.y.set_lane(i, ddx(first + i).y);
+      dy.x.set_lane(i, ddy(first + i).x);
+      dy.y.set_lane(i, ddy(first + i).y);
     }
     // The pair, and the two bound as a SampledTexture (the built-in shaders' way): the same.
     const SampledTexture bound(texture, sampler);
@@ -133,7 +141,7 @@ void expect_sampler_matches_scalar(const Texture& texture, const Sampler& sample
       for (int i = 0; i < simd::kLanes; ++i) {
         glm::vec4 want =
             sampler.filter == Filter::kTrilinear
-                ? texture.sample(sampler, uvs[first + i], test_ddx(first + i), test_ddy(first + i))
+                ? texture.sample(sampler, uvs[first + i], ddx(first + i), ddy(first + i))
                 : texture.sample(sampler, uvs[first + i]);
         ASSERT_EQ(got.x.lane(i), want.r) << (way == 0 ? "pair" : "bound") << ", uv "
                                          << uvs[first + i].x << "," << uvs[first + i].y;
@@ -158,21 +166,22 @@ void expect_sampler_matches_scalar(const Texture& texture, const Sampler& sample
 // Runs the check inside a function compiled for the level, as the fragment stage does.
 template <int N>
 void check_sampler_at_native_width(const Texture& t, const Sampler& s,
-                                   const std::vector<glm::vec2>& uvs);
+                                   const std::vector<glm::vec2>& uvs, Lod lod = Lod::kWide);
 template <>
 void check_sampler_at_native_width<4>(const Texture& t, const Sampler& s,
-                                      const std::vector<glm::vec2>& uvs) {
-  expect_sampler_matches_scalar<4>(t, s, uvs);
+                                      const std::vector<glm::vec2>& uvs, Lod lod) {
+  expect_sampler_matches_scalar<4>(t, s, uvs, lod);
 }
 template <>
 [[gnu::target("avx2")]] void check_sampler_at_native_width<8>(const Texture& t, const Sampler& s,
-                                                              const std::vector<glm::vec2>& uvs) {
-  expect_sampler_matches_scalar<8>(t, s, uvs);
+                                                              const std::vector<glm::vec2>& uvs,
+                                                              Lod lod) {
+  expect_sampler_matches_scalar<8>(t, s, uvs, lod);
 }
 template <>
 [[gnu::target("avx512f,avx512bw,avx512dq,avx512vl")]] void check_sampler_at_native_width<16>(
-    const Texture& t, const Sampler& s, const std::vector<glm::vec2>& uvs) {
-  expect_sampler_matches_scalar<16>(t, s, uvs);
+    const Texture& t, const Sampler& s, const std::vector<glm::vec2>& uvs, Lod lod) {
+  expect_sampler_matches_scalar<16>(t, s, uvs, lod);
 }
 
 Texture noise_texture(int width, int height, unsigned seed, bool srgb = false) {
@@ -443,16 +452,20 @@ TEST(SimdSampler, MatchesScalarSamplingBitForBitAtEveryLevel) {
           SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + " filter " +
                        std::to_string(int(filter)) + " wrap " + std::to_string(int(wrap_u)) + "," +
                        std::to_string(int(wrap_v)) + (srgb ? " srgb" : ""));
-          check_sampler_at_native_width<4>(texture, sampler, uvs);
-          // Both ways of gathering texels: the instruction and one load per lane.
-          for (GatherMode mode : {GatherMode::kInstruction, GatherMode::kLoads}) {
-            SCOPED_TRACE(gather_mode_name(mode));
-            set_gather_mode(mode);
-            if (cpu_simd_level() >= SimdLevel::kAvx2) {
-              check_sampler_at_native_width<8>(texture, sampler, uvs);
-            }
-            if (cpu_simd_level() >= SimdLevel::kAvx512) {
-              check_sampler_at_native_width<16>(texture, sampler, uvs);
+          for (Lod lod : {Lod::kWide, Lod::kNear}) {
+            if (lod == Lod::kNear && filter != Filter::kTrilinear) continue;
+            SCOPED_TRACE(lod == Lod::kNear ? "lod near the base" : "lod over every level");
+            check_sampler_at_native_width<4>(texture, sampler, uvs, lod);
+            // Both ways of gathering texels: the instruction and one load per lane.
+            for (GatherMode mode : {GatherMode::kInstruction, GatherMode::kLoads}) {
+              SCOPED_TRACE(gather_mode_name(mode));
+              set_gather_mode(mode);
+              if (cpu_simd_level() >= SimdLevel::kAvx2) {
+                check_sampler_at_native_width<8>(texture, sampler, uvs, lod);
+              }
+              if (cpu_simd_level() >= SimdLevel::kAvx512) {
+                check_sampler_at_native_width<16>(texture, sampler, uvs, lod);
+              }
             }
           }
         }

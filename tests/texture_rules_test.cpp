@@ -494,8 +494,9 @@ TEST(TextureRules, TranslucentCountsAreasNotStrayTexels) {
 }
 
 // The AVX-512 sampler's row pairs: element (i, j) holds texel (i, j) and the one above it, each
-// row clamped to the texture, for j from -1 to the last row; built once, for copies too; none for
-// an empty texture or above kMaxRowPairTexels texels.
+// row clamped to the texture, for j from -1 to the last row, of the base level and of every level
+// of the chain; built once, for copies too; none for an empty texture or above kMaxRowPairTexels
+// texels.
 TEST(TextureRules, RowPairsHoldEachTexelAndTheOneAboveClampedAtBothEdges) {
   EXPECT_EQ(Texture().row_pairs(), nullptr);
   const Image image = noise_image(5, 3, 17);
@@ -518,7 +519,29 @@ TEST(TextureRules, RowPairsHoldEachTexelAndTheOneAboveClampedAtBothEdges) {
     }
   }
   EXPECT_NE(copy.row_pairs(), t.row_pairs());  // the copy's own
+  // The chain's pairs, level by level (5x3, 2x1, 1x1), from the levels' own texels.
+  const Texture::RowPairChain chain = t.row_pair_chain();
+  ASSERT_NE(chain.pairs, nullptr);
+  ASSERT_EQ(t.levels(), 3);
+  for (int k = 0; k < t.levels(); ++k) {
+    const MipLevel& level = t.level(k);
+    auto texel = [&](int i, int j) {
+      uint32_t v;
+      std::memcpy(&v, t.texels() + (level.offset + size_t(j) * level.width + size_t(i)) * 4, 4);
+      return v;
+    };
+    for (int j = -1; j < level.height; ++j) {
+      for (int i = 0; i < level.width; ++i) {
+        const uint64_t want =
+            texel(i, std::max(j, 0)) | uint64_t(texel(i, std::min(j + 1, level.height - 1))) << 32;
+        EXPECT_EQ(chain.pairs[chain.level_row0[k] + j * level.width + i], want)
+            << "level " << k << " pair " << i << "," << j;
+      }
+    }
+  }
+  EXPECT_EQ(t.row_pair_chain().pairs, chain.pairs);  // kept
   EXPECT_EQ(Texture::from_image(Image(2049, 2048)).row_pairs(), nullptr);
+  EXPECT_EQ(Texture::from_image(Image(2049, 2048)).row_pair_chain().pairs, nullptr);
   EXPECT_NE(Texture::from_image(Image(2048, 2048)).row_pairs(), nullptr);
 }
 

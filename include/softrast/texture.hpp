@@ -163,6 +163,14 @@ class Texture {
   // null for an empty texture and above kMaxRowPairTexels texels (twice the base level's memory).
   const uint64_t* row_pairs() const;
   static constexpr size_t kMaxRowPairTexels = size_t(1) << 22;
+  // The same for every level of the mip chain (built first if it is not), for the AVX-512
+  // trilinear sampler: level k's pair (i, j) is pairs[level_row0[k] + j * width_k + i], j from -1
+  // as above. Null pointers where row_pairs() is null.
+  struct RowPairChain {
+    const uint64_t* pairs = nullptr;
+    const int32_t* level_row0 = nullptr;
+  };
+  RowPairChain row_pair_chain() const;
 
   // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
   static int wrap(Wrap mode, int i, int size);
@@ -233,7 +241,12 @@ class Texture {
     std::atomic<int> translucent{-1};  // translucent(): -1 until computed
     std::vector<uint64_t> pairs;       // row_pairs(): written once, under `mutex`
     std::atomic<const uint64_t*> pairs_row0{nullptr};
+    std::vector<uint64_t> chain_pairs;  // row_pair_chain(): written once, under `mutex`
+    std::vector<int32_t> chain_row0;
+    std::atomic<bool> chain_ready{false};
   };
+  // Level `level`'s texels as row pairs, rows -1 to height - 1, into `out`.
+  void pair_rows(const MipLevel& level, uint64_t* out) const;
   void build_mips() const;
   bool compute_translucent() const;
   static std::vector<MipLevel> mip_levels(int width, int height);

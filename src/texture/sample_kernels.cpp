@@ -121,10 +121,16 @@ SOFTRAST_AVX512_FN Texels16 lerp16(const Texels16& a, const Texels16& b, __m512 
 // sample_level's bilinear branch for one level per lane (size w x h, first texel `offset`): the
 // texels (bilinear_texels) and then the filter; `row_shift` is log2(w) when every lane has that
 // power-of-two width (the rows start at j << it), else -1 (j * w).
+// With `pairs` (the chain's row pairs, Texture::row_pair_chain, for a sampler that clamps each
+// axis or repeats it over a power-of-two size; `pair_row0`: each lane's level's row 0 there), the
+// texels come from them where every lane's columns are neighbours and no repeated row wraps
+// (avx512::bilinear_texels16's way), else from the level's rows.
 SOFTRAST_AVX512_FN void bilinear16_texels(const Texture& t, const Sampler& s, __m512 u, __m512 v,
                                           __m512i w, __m512i h, __m512i offset, bool pow2_u,
                                           bool pow2_v, int row_shift, __m512i& b0, __m512i& b1,
-                                          __m512i& t0, __m512i& t1, __m512& fx, __m512& fy) {
+                                          __m512i& t0, __m512i& t1, __m512& fx, __m512& fy,
+                                          const int64_t* pairs = nullptr,
+                                          __m512i pair_row0 = __m512i{}) {
   __m512i x0 = avx512::floor16(
       _mm512_sub_ps(_mm512_mul_ps(u, _mm512_cvtepi32_ps(w)), _mm512_set1_ps(0.5f)), fx);
   __m512i y0 = avx512::floor16(
@@ -132,6 +138,26 @@ SOFTRAST_AVX512_FN void bilinear16_texels(const Texture& t, const Sampler& s, __
   const __m512i one = _mm512_set1_epi32(1);
   __m512i i0 = wrap16(s.wrap_u, x0, w, pow2_u);
   __m512i i1 = wrap16(s.wrap_u, _mm512_add_epi32(x0, one), w, pow2_u);
+  if (pairs != nullptr) {
+    using V = simd::Native<16>::I;
+    const V last = V(h) - 1;
+    V r = V(y0);
+    __mmask16 wraps = 0;
+    if (s.wrap_v == Wrap::kRepeat) {
+      r &= last;
+      wraps = _mm512_cmpeq_epi32_mask(__m512i(r), __m512i(last));
+    } else {
+      r = r < -1 ? V{} - 1 : r;
+      r = r > last ? last : r;
+    }
+    if ((_mm512_cmpneq_epi32_mask(i1, _mm512_add_epi32(i0, one)) | wraps) == 0) {
+      const V rows = row_shift >= 0 ? r << row_shift : r * V(w);
+      V lb, rb, lt, rt;
+      avx512::load_row_pairs16(pairs, V(pair_row0) + rows + V(i0), lb, rb, lt, rt);
+      b0 = __m512i(lb), b1 = __m512i(rb), t0 = __m512i(lt), t1 = __m512i(rt);
+      return;
+    }
+  }
   __m512i j0 = wrap16(s.wrap_v, y0, h, pow2_v);
   __m512i j1 = wrap16(s.wrap_v, _mm512_add_epi32(y0, one), h, pow2_v);
   __m512i row0, row1;
@@ -154,10 +180,12 @@ SOFTRAST_AVX512_FN void bilinear16_texels(const Texture& t, const Sampler& s, __
 
 SOFTRAST_AVX512_FN Texels16 bilinear16(const Texture& t, const Sampler& s, __m512 u, __m512 v,
                                        __m512i w, __m512i h, __m512i offset, bool pow2_u,
-                                       bool pow2_v, int row_shift) {
+                                       bool pow2_v, int row_shift, const int64_t* pairs = nullptr,
+                                       __m512i pair_row0 = __m512i{}) {
   __m512i b0, b1, t0, t1;
   __m512 fx, fy;
-  bilinear16_texels(t, s, u, v, w, h, offset, pow2_u, pow2_v, row_shift, b0, b1, t0, t1, fx, fy);
+  bilinear16_texels(t, s, u, v, w, h, offset, pow2_u, pow2_v, row_shift, b0, b1, t0, t1, fx, fy,
+                    pairs, pair_row0);
   simd::Vec4<16> c = filter_rgba8<16>(as_lanes(b0), as_lanes(b1), as_lanes(t0), as_lanes(t1),
                                       as_lanes(fx), as_lanes(fy));
   return {__m512(c.x.p[0]), __m512(c.y.p[0]), __m512(c.z.p[0]), __m512(c.w.p[0])};
@@ -177,6 +205,14 @@ SOFTRAST_AVX512_FN int row_shift16(const simd::Int<16>& w, bool pow2) {
   const int32_t first = w.lane(0);
   return pow2 && simd::bits(w == simd::Int<16>(first)) == 0xffffu ? __builtin_ctz(unsigned(first))
                                                                   : -1;
+}
+
+// Each lane's level's row 0 in the chain's row pairs (level_lanes' way: one read where the lanes
+// share their level).
+SOFTRAST_AVX512_FN __m512i level_row0_16(const int32_t* level_row0, const simd::Int<16>& l) {
+  const int32_t first = l.lane(0);
+  if (simd::bits(l == simd::Int<16>(first)) == 0xffffu) return _mm512_set1_epi32(level_row0[first]);
+  return __m512i(simd::gather<16>(level_row0, l, kTexelRoute).p[0]);
 }
 
 // sample_inline, both forms, for bilinear and trilinear samplers without sRGB decode.
@@ -200,15 +236,27 @@ SOFTRAST_AVX512_FN void filtered16(const Texture& texture, const Sampler& s, Sam
   trilinear_levels<16>(texture, {F::load(io.in[2]), F::load(io.in[3])},
                        {F::load(io.in[4]), F::load(io.in[5])}, l0, l1, t);
   texture.ensure_mips();
+  // The chain's row pairs where the texels are read by loads and each axis clamps or repeats
+  // over a power of two.
+  const auto paired = [&](Wrap mode, bool pow2) {
+    return mode == Wrap::kClampToEdge || (mode == Wrap::kRepeat && pow2);
+  };
+  Texture::RowPairChain chain;
+  if (simd::loads_for_gathers<16>() && paired(s.wrap_u, pow2_u) && paired(s.wrap_v, pow2_v)) {
+    chain = texture.row_pair_chain();
+  }
+  const auto* pairs = reinterpret_cast<const int64_t*>(chain.pairs);
   I w0, h0, o0;
   level_lanes<16>(texture, l0, w0, h0, o0);
   Texels16 c = bilinear16(texture, s, u, v, __m512i(w0.p[0]), __m512i(h0.p[0]), __m512i(o0.p[0]),
-                          pow2_u, pow2_v, row_shift16(w0, pow2_u));
+                          pow2_u, pow2_v, row_shift16(w0, pow2_u), pairs,
+                          pairs ? level_row0_16(chain.level_row0, l0) : __m512i{});
   if (simd::any(t > F(0.0f))) {  // else every lane's second weight is 0 (sample_inline)
     I w1, h1, o1;
     level_lanes<16>(texture, l1, w1, h1, o1);
     Texels16 c1 = bilinear16(texture, s, u, v, __m512i(w1.p[0]), __m512i(h1.p[0]), __m512i(o1.p[0]),
-                             pow2_u, pow2_v, row_shift16(w1, pow2_u));
+                             pow2_u, pow2_v, row_shift16(w1, pow2_u), pairs,
+                             pairs ? level_row0_16(chain.level_row0, l1) : __m512i{});
     c = lerp16(c, c1, __m512(t.p[0]));
   }
   store16(c, io);

@@ -225,23 +225,51 @@ void Texture::wrap_lanes(Wrap mode, int32_t* indices, const int32_t* sizes, int 
   for (int k = 0; k < count; ++k) indices[k] = wrap(mode, indices[k], sizes[k]);
 }
 
+void Texture::pair_rows(const MipLevel& level, uint64_t* out) const {
+  const size_t w = size_t(level.width);
+  const int h = level.height;
+  const auto* texels = reinterpret_cast<const uint32_t*>(texels_.data()) + level.offset;
+  for (int j = -1; j < h; ++j) {
+    const uint32_t* lower = texels + size_t(std::max(j, 0)) * w;
+    const uint32_t* upper = texels + size_t(std::min(j + 1, h - 1)) * w;
+    uint64_t* row = out + size_t(j + 1) * w;
+    for (size_t i = 0; i < w; ++i) row[i] = uint64_t(lower[i]) | uint64_t(upper[i]) << 32;
+  }
+}
+
 const uint64_t* Texture::row_pairs() const {
   if (!mips_ || size_t(width_) * size_t(height_) > kMaxRowPairTexels) return nullptr;
   if (const uint64_t* row0 = mips_->pairs_row0.load(std::memory_order_acquire)) return row0;
   std::lock_guard<std::mutex> lock(mips_->mutex);
   if (const uint64_t* row0 = mips_->pairs_row0.load(std::memory_order_relaxed)) return row0;
-  const size_t w = size_t(width_);
-  const auto* texels = reinterpret_cast<const uint32_t*>(texels_.data());
-  std::vector<uint64_t>& pairs = mips_->pairs;
-  pairs.resize(w * (size_t(height_) + 1));
-  for (int j = -1; j < height_; ++j) {
-    const uint32_t* lower = texels + size_t(std::max(j, 0)) * w;
-    const uint32_t* upper = texels + size_t(std::min(j + 1, height_ - 1)) * w;
-    uint64_t* out = pairs.data() + size_t(j + 1) * w;
-    for (size_t i = 0; i < w; ++i) out[i] = uint64_t(lower[i]) | uint64_t(upper[i]) << 32;
+  const MipLevel& base = levels_[0];
+  mips_->pairs.resize(size_t(base.width) * (size_t(base.height) + 1));
+  pair_rows(base, mips_->pairs.data());
+  const uint64_t* row0 = mips_->pairs.data() + base.width;
+  mips_->pairs_row0.store(row0, std::memory_order_release);
+  return row0;
+}
+
+Texture::RowPairChain Texture::row_pair_chain() const {
+  if (!mips_ || size_t(width_) * size_t(height_) > kMaxRowPairTexels) return {};
+  if (!mips_->chain_ready.load(std::memory_order_acquire)) {
+    ensure_mips();  // (takes the mutex itself)
+    std::lock_guard<std::mutex> lock(mips_->mutex);
+    if (!mips_->chain_ready.load(std::memory_order_relaxed)) {
+      size_t total = 0;
+      for (const MipLevel& l : levels_) total += size_t(l.width) * (size_t(l.height) + 1);
+      mips_->chain_pairs.resize(total);
+      mips_->chain_row0.resize(levels_.size());
+      size_t at = 0;
+      for (size_t k = 0; k < levels_.size(); ++k) {
+        pair_rows(levels_[k], mips_->chain_pairs.data() + at);
+        mips_->chain_row0[k] = int32_t(at + size_t(levels_[k].width));
+        at += size_t(levels_[k].width) * (size_t(levels_[k].height) + 1);
+      }
+      mips_->chain_ready.store(true, std::memory_order_release);
+    }
   }
-  mips_->pairs_row0.store(pairs.data() + w, std::memory_order_release);
-  return pairs.data() + w;
+  return {mips_->chain_pairs.data(), mips_->chain_row0.data()};
 }
 
 bool Texture::translucent() const {
