@@ -159,8 +159,11 @@ class Texture {
   // (i, j) is the 64-bit pair of texels (i, clamp(j)) and (i, clamp(j + 1)), rows clamped to the
   // edge, for j from -1 (the returned pointer's row 0 is j = 0; row -1 lies before it). So one
   // 128-bit load at (i, j) holds all four texels a bilinear sample of rows j and j + 1 and
-  // columns i and i + 1 reads. Built on first call (safe from several threads at once) and kept;
-  // null for an empty texture and above kMaxRowPairTexels texels (twice the base level's memory).
+  // columns i and i + 1 reads. The copy costs twice the base level's memory and pays over
+  // repeated draws: it is built (once, safe from several threads at once) from the texture's
+  // second binding for a draw (SampledTexture) on, so a texture drawn once, as in a single
+  // rendered image, never pays for it. Null before that, for an empty texture and above
+  // kMaxRowPairTexels texels.
   const uint64_t* row_pairs() const;
   static constexpr size_t kMaxRowPairTexels = size_t(1) << 22;
   // The same for every level of the mip chain (built first if it is not), for the AVX-512
@@ -171,6 +174,8 @@ class Texture {
     const int32_t* level_row0 = nullptr;
   };
   RowPairChain row_pair_chain() const;
+  // How many times the texture was bound for a draw (SampledTexture's constructor counts).
+  int draw_bindings() const { return mips_ ? mips_->bindings.load(std::memory_order_relaxed) : 0; }
 
   // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
   static int wrap(Wrap mode, int i, int size);
@@ -244,7 +249,13 @@ class Texture {
     std::vector<uint64_t> chain_pairs;  // row_pair_chain(): written once, under `mutex`
     std::vector<int32_t> chain_row0;
     std::atomic<bool> chain_ready{false};
+    std::atomic<int> bindings{0};  // draw_bindings()
   };
+  friend class SampledTexture;  // counts the bindings
+  // Whether the row pairs may be built: the base level is small enough, and bound twice.
+  bool pairs_allowed() const {
+    return mips_ && size_t(width_) * size_t(height_) <= kMaxRowPairTexels && draw_bindings() >= 2;
+  }
   // Level `level`'s texels as row pairs, rows -1 to height - 1, into `out`.
   void pair_rows(const MipLevel& level, uint64_t* out) const;
   void build_mips() const;
@@ -294,10 +305,6 @@ struct BilinearPlan {
     p.repeat_v = s.wrap_v == Wrap::kRepeat;
     p.row_width = w;
     p.row_shift = pow2_u ? __builtin_ctz(unsigned(w)) : -1;
-    if (simd_level() == SimdLevel::kAvx512 &&
-        gather_mode(SimdLevel::kAvx512) == GatherMode::kLoads) {
-      p.pairs = reinterpret_cast<const int64_t*>(t.row_pairs());
-    }
     return p;
   }
 };
@@ -311,10 +318,26 @@ struct BilinearPlan {
 class SampledTexture {
  public:
   SampledTexture() : texture_(&no_texture()) {}  // samples as opaque white, as an empty texture
+  // Binds `texture` for a draw (counted: Texture::row_pairs).
   SampledTexture(const Texture& texture, const Sampler& sampler)
       : texture_(&texture),
         sampler_(sampler),
-        bilinear_(detail::BilinearPlan::of(texture, sampler)) {}
+        bilinear_(detail::BilinearPlan::of(texture, sampler)) {
+    if (texture.mips_) texture.mips_->bindings.fetch_add(1, std::memory_order_relaxed);
+    if (bilinear_.texels != nullptr && simd_level() == SimdLevel::kAvx512 &&
+        gather_mode(SimdLevel::kAvx512) == GatherMode::kLoads) {
+      bilinear_.pairs = reinterpret_cast<const int64_t*>(texture.row_pairs());
+    }
+  }
+  // The same for one sample call (sample(texture, sampler, uv)): not a draw's binding, so neither
+  // counted nor reading the row pairs.
+  static SampledTexture for_one_call(const Texture& texture, const Sampler& sampler) {
+    SampledTexture bound;
+    bound.texture_ = &texture;
+    bound.sampler_ = sampler;
+    bound.bilinear_ = detail::BilinearPlan::of(texture, sampler);
+    return bound;
+  }
   const Texture& texture() const { return *texture_; }
   const Sampler& sampler() const { return sampler_; }
   // The common case's plan, or null where another path samples.

@@ -238,7 +238,7 @@ void Texture::pair_rows(const MipLevel& level, uint64_t* out) const {
 }
 
 const uint64_t* Texture::row_pairs() const {
-  if (!mips_ || size_t(width_) * size_t(height_) > kMaxRowPairTexels) return nullptr;
+  if (!pairs_allowed()) return nullptr;
   if (const uint64_t* row0 = mips_->pairs_row0.load(std::memory_order_acquire)) return row0;
   std::lock_guard<std::mutex> lock(mips_->mutex);
   if (const uint64_t* row0 = mips_->pairs_row0.load(std::memory_order_relaxed)) return row0;
@@ -251,7 +251,7 @@ const uint64_t* Texture::row_pairs() const {
 }
 
 Texture::RowPairChain Texture::row_pair_chain() const {
-  if (!mips_ || size_t(width_) * size_t(height_) > kMaxRowPairTexels) return {};
+  if (!pairs_allowed()) return {};
   if (!mips_->chain_ready.load(std::memory_order_acquire)) {
     ensure_mips();  // (takes the mutex itself)
     std::lock_guard<std::mutex> lock(mips_->mutex);

@@ -602,7 +602,7 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const SampledTexture& t, const simd::V
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const Texture& texture, const Sampler& s,
                                           const simd::Vec2<N>& uv) {
-  return sample<N>(SampledTexture(texture, s), uv);
+  return sample<N>(SampledTexture::for_one_call(texture, s), uv);
 }
 
 // sample() packed as RGBA8 (red in the low byte): exactly pack_rgba8(sample(...)), lane by lane,
@@ -637,7 +637,7 @@ SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8(const SampledTexture& t, const si
 template <int N>
 SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8(const Texture& texture, const Sampler& s,
                                                const simd::Vec2<N>& uv) {
-  return sample_rgba8<N>(SampledTexture(texture, s), uv);
+  return sample_rgba8<N>(SampledTexture::for_one_call(texture, s), uv);
 }
 
 // The same with the texture coordinates' change to the next pixel right and down (for example
