@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "softrast/renderer.hpp"
 #include "softrast/shader.hpp"
 
 namespace {
@@ -144,6 +145,36 @@ TEST(Allocation, SecondFrameOfTheSameSceneAllocatesNothing) {
     long before = g_allocations.load();
     for (int threads : {1, 2, 1}) frame(threads);
     EXPECT_EQ(g_allocations.load() - before, 0) << samples << " samples, deferrable " << deferrable;
+  }
+}
+
+// The same through the renderer for a textured scene: the demo scene (its textures, the floor
+// sampled trilinearly) with the texture shader and phong, bilinear and trilinear. The first
+// frame builds what the draws keep (the mip chains, the textures' row pairs, the bins); the
+// frames after it allocate nothing.
+TEST(Allocation, LaterFramesOfATexturedSceneAllocateNothing) {
+  DemoScene demo = make_demo_scene();
+  Image checker(64, 64);
+  for (size_t k = 0; k < checker.rgba.size(); ++k) checker.rgba[k] = uint8_t(k * 37 + k / 256);
+  for (ShaderKind shader : {ShaderKind::kTexture, ShaderKind::kPhong}) {
+    for (Filter filter : {Filter::kBilinear, Filter::kTrilinear}) {
+      RenderOptions options;
+      options.shader = shader;
+      options.sampler.filter = filter;
+      options.texture = std::make_shared<const Texture>(Texture::from_image(checker));
+      options.state.cull = CullMode::kBack;
+      Framebuffer fb(320, 240);
+      options.state.threads = 2;
+      auto frame = [&] {
+        fb.clear();
+        render_mesh(fb, demo.mesh, demo.camera, options);
+      };
+      frame();
+      long before = g_allocations.load();
+      for (int k = 0; k < 3; ++k) frame();
+      EXPECT_EQ(g_allocations.load() - before, 0)
+          << shader_kind_name(shader) << ", filter " << int(filter);
+    }
   }
 }
 

@@ -172,7 +172,12 @@ Status run_job(Job& job) {
   if (job.frames > 0) {
     if (Status s = benchmark(job); !s.ok()) return s;
   } else {
+    // One image: each texture is drawn once, too few times to repay a copy in row pairs
+    // (set_texture_row_pairs), whose memory would only raise the peak.
+    const bool row_pairs = texture_row_pairs();
+    set_texture_row_pairs(false);
     double ms = render_frame(job).wall_ms;
+    set_texture_row_pairs(row_pairs);
     progress(job, "rendered " + size_text(job) + " in " + format("%.1f", ms) + " ms");
   }
   if (!job.output) return {};

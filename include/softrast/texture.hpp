@@ -72,6 +72,15 @@ inline float fast_log2(float x) {
 // An RGBA8 texture with its mip chain. Texel (i, j) has its centre at ((i + 0.5) / width,
 // (j + 0.5) / height) in (u, v); j = 0 is the bottom row of the picture. Channels are read as
 // linear values in [0, 1].
+// Whether textures bound for a draw keep a copy of their texels in row pairs (Texture::row_pairs,
+// row_pair_chain) for the AVX-512 sampler: bilinear and trilinear sampling faster (quad_grid
+// texture about 13 %), for twice the texture's memory (three times with its mip chain), built at
+// its first draw. On by default. A program that draws each texture once (one image) saves that
+// time and memory by turning it off: the command line's `render` does when it draws one image.
+// Not to be changed while a draw is running on another thread.
+void set_texture_row_pairs(bool on);
+bool texture_row_pairs();
+
 class Texture {
  public:
   Texture() = default;
@@ -159,10 +168,9 @@ class Texture {
   // (i, j) is the 64-bit pair of texels (i, clamp(j)) and (i, clamp(j + 1)), rows clamped to the
   // edge, for j from -1 (the returned pointer's row 0 is j = 0; row -1 lies before it). So one
   // 128-bit load at (i, j) holds all four texels a bilinear sample of rows j and j + 1 and
-  // columns i and i + 1 reads. The copy costs twice the base level's memory and pays over
-  // repeated draws: it is built (once, safe from several threads at once) from the texture's
-  // second binding for a draw (SampledTexture) on, so a texture drawn once, as in a single
-  // rendered image, never pays for it. Null before that, for an empty texture and above
+  // columns i and i + 1 reads. Built once (safe from several threads at once) when the texture
+  // is first bound for a draw (SampledTexture), so draws after the first allocate nothing. Null
+  // before that, with set_texture_row_pairs(false), for an empty texture and above
   // kMaxRowPairTexels texels.
   const uint64_t* row_pairs() const;
   static constexpr size_t kMaxRowPairTexels = size_t(1) << 22;
@@ -252,9 +260,11 @@ class Texture {
     std::atomic<int> bindings{0};  // draw_bindings()
   };
   friend class SampledTexture;  // counts the bindings
-  // Whether the row pairs may be built: the base level is small enough, and bound twice.
+  // Whether the row pairs may be built: the base level is small enough, bound for a draw, and
+  // the copies are on.
   bool pairs_allowed() const {
-    return mips_ && size_t(width_) * size_t(height_) <= kMaxRowPairTexels && draw_bindings() >= 2;
+    return mips_ && size_t(width_) * size_t(height_) <= kMaxRowPairTexels && draw_bindings() >= 1 &&
+           texture_row_pairs();
   }
   // Level `level`'s texels as row pairs, rows -1 to height - 1, into `out`.
   void pair_rows(const MipLevel& level, uint64_t* out) const;

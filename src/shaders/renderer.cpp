@@ -287,14 +287,23 @@ void render_mesh(Framebuffer& framebuffer, const Mesh& input, const Camera& came
   const Mesh& mesh = complete_mesh(input, storage, needs_tangents(input, options));
   float aspect = float(framebuffer.width()) / float(framebuffer.height());
   glm::mat4 mvp = camera.view_projection(aspect);
-  std::vector<SubMesh> runs = mesh.submeshes;
-  if (runs.empty()) runs.push_back({0, uint32_t(mesh.indices.size()), -1});
+  // The mesh's runs as they are (no copy, so that a frame after the first allocates nothing), or
+  // one run of every index; runs past the indices (a malformed mesh) dropped, in a copy.
+  const SubMesh whole{0, uint32_t(mesh.indices.size()), -1};
+  std::span<const SubMesh> runs(&whole, 1);
+  if (!mesh.submeshes.empty()) runs = mesh.submeshes;
+  auto outside = [&](const SubMesh& run) {
+    return size_t(run.first_index) + run.index_count > mesh.indices.size();
+  };
+  std::vector<SubMesh> valid;
+  if (std::any_of(runs.begin(), runs.end(), outside)) {
+    valid.assign(runs.begin(), runs.end());
+    std::erase_if(valid, outside);
+    runs = valid;
+  }
 
   RenderState state = options.state;
   if (options.shader == ShaderKind::kWireframe) state.wireframe = true;
-  std::erase_if(runs, [&](const SubMesh& run) {
-    return size_t(run.first_index) + run.index_count > mesh.indices.size();
-  });
   DepthRange depth{camera.near_plane, camera.far_plane};
   if (options.shader == ShaderKind::kDepth) {
     depth = visible_depth_range(framebuffer.width(), framebuffer.height(), mesh, camera, mvp, runs,

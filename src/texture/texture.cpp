@@ -225,6 +225,17 @@ void Texture::wrap_lanes(Wrap mode, int32_t* indices, const int32_t* sizes, int 
   for (int k = 0; k < count; ++k) indices[k] = wrap(mode, indices[k], sizes[k]);
 }
 
+namespace {
+std::atomic<bool> g_row_pairs{true};
+}  // namespace
+
+void set_texture_row_pairs(bool on) {
+  g_row_pairs.store(on, std::memory_order_relaxed);
+}
+bool texture_row_pairs() {
+  return g_row_pairs.load(std::memory_order_relaxed);
+}
+
 void Texture::pair_rows(const MipLevel& level, uint64_t* out) const {
   const size_t w = size_t(level.width);
   const int h = level.height;
