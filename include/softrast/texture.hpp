@@ -295,8 +295,9 @@ struct BilinearPlan {
   bool repeat_u = false, repeat_v = false;  // else clamped to the edge
   int32_t row_width = 0;                    // texels per row
   int row_shift = -1;                       // log2(row_width) for a power of two, else -1
-  // Texture::row_pairs() where the sampler reads texels by loads (gather_mode kLoads) at AVX-512,
-  // else null (the gather instruction reads the rows as they are).
+  // Texture::row_pairs(), set by SampledTexture's constructor where the sampler reads texels by
+  // loads (gather_mode kLoads) at AVX-512; else null: of() leaves it so, and the gather
+  // instruction reads the rows as they are.
   const int64_t* pairs = nullptr;
 
   static BilinearPlan of(const Texture& t, const Sampler& s) {
