@@ -182,7 +182,8 @@ class Texture {
     const int32_t* level_row0 = nullptr;
   };
   RowPairChain row_pair_chain() const;
-  // How many times the texture was bound for a draw (SampledTexture's constructor counts).
+  // How many times the texture was bound for a draw (SampledTexture's constructor counts, up to
+  // 2^30).
   int draw_bindings() const { return mips_ ? mips_->bindings.load(std::memory_order_relaxed) : 0; }
 
   // Wraps texel index i into [0, size) by the OpenGL rules for each mode.
@@ -334,7 +335,10 @@ class SampledTexture {
       : texture_(&texture),
         sampler_(sampler),
         bilinear_(detail::BilinearPlan::of(texture, sampler)) {
-    if (texture.mips_) texture.mips_->bindings.fetch_add(1, std::memory_order_relaxed);
+    // (Counted up to 2^30: a program that binds a texture per block cannot wrap the count.)
+    if (texture.mips_ && texture.mips_->bindings.load(std::memory_order_relaxed) < (1 << 30)) {
+      texture.mips_->bindings.fetch_add(1, std::memory_order_relaxed);
+    }
     if (bilinear_.texels != nullptr && simd_level() == SimdLevel::kAvx512 &&
         gather_mode(SimdLevel::kAvx512) == GatherMode::kLoads) {
       bilinear_.pairs = reinterpret_cast<const int64_t*>(texture.row_pairs());
