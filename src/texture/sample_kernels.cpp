@@ -140,16 +140,8 @@ SOFTRAST_AVX512_FN void bilinear16_texels(const Texture& t, const Sampler& s, __
   __m512i i1 = wrap16(s.wrap_u, _mm512_add_epi32(x0, one), w, pow2_u);
   if (pairs != nullptr) {
     using V = simd::Native<16>::I;
-    const V last = V(h) - 1;
-    V r = V(y0);
-    __mmask16 wraps = 0;
-    if (s.wrap_v == Wrap::kRepeat) {
-      r &= last;
-      wraps = _mm512_cmpeq_epi32_mask(__m512i(r), __m512i(last));
-    } else {
-      r = r < -1 ? V{} - 1 : r;
-      r = r > last ? last : r;
-    }
+    __mmask16 wraps;
+    const V r = avx512::pair_row16(s.wrap_v == Wrap::kRepeat, V(y0), V(h) - 1, wraps);
     if ((_mm512_cmpneq_epi32_mask(i1, _mm512_add_epi32(i0, one)) | wraps) == 0) {
       const V rows = row_shift >= 0 ? r << row_shift : r * V(w);
       V lb, rb, lt, rt;

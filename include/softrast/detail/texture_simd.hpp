@@ -267,6 +267,22 @@ SOFTRAST_AVX512_SAMPLER void gather_bilinear16(
   simd::isa::gather(texels, row1 + i1, t1);
 }
 
+// The row pair (Texture::row_pairs) of each lane's lower row y0, for rows up to `last`: clamped,
+// y0 within [-1, last] names both rows; repeated over a power of two, y0 & last does, except on
+// the last row, whose upper row wraps to row 0 (those lanes set in `wraps`, to be gathered).
+SOFTRAST_AVX512_SAMPLER simd::Native<16>::I pair_row16(bool repeat, simd::Native<16>::I y0,
+                                                       simd::Native<16>::I last, __mmask16& wraps) {
+  using V = simd::Native<16>::I;
+  wraps = 0;
+  if (repeat) {
+    const V r = y0 & last;
+    wraps = _mm512_cmpeq_epi32_mask(__m512i(r), __m512i(last));
+    return r;
+  }
+  const V r = y0 < -1 ? V{} - 1 : y0;
+  return r > last ? last : r;
+}
+
 // The four texels of every lane from the row pairs (Texture::row_pairs), where each lane's
 // columns are neighbours: one 128-bit load per lane at its pair `at` holds b0, t0, b1 and t1, and
 // a 4x4 transpose within each 128-bit part sorts them into the four vectors (as the triangle
@@ -325,18 +341,9 @@ SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const BilinearPlan& p, const simd
   fxl.p[0] = simd::Native<16>::F(fx);
   fyl.p[0] = simd::Native<16>::F(fy);
   if (p.pairs != nullptr) {
-    // The row pairs (Texture::row_pairs): the pair at row r holds rows clamp(r) and clamp(r + 1),
-    // for r from -1. Clamped, y0 itself within [-1, last] names both rows; repeated, y0 & last
-    // does unless it is the last row (whose upper row wraps to row 0: the gathers below).
-    V r = V(y0);
-    __mmask16 wraps = 0;
-    if (p.repeat_v) {
-      r &= p.last_v;
-      wraps = _mm512_cmpeq_epi32_mask(__m512i(r), _mm512_set1_epi32(p.last_v));
-    } else {
-      r = r < -1 ? V{} - 1 : r;
-      r = r > p.last_v ? V{} + p.last_v : r;
-    }
+    // The row pairs (Texture::row_pairs), read where no lane's columns or rows wrap.
+    __mmask16 wraps;
+    const V r = pair_row16(p.repeat_v, V(y0), V{} + p.last_v, wraps);
     if ((_mm512_cmpneq_epi32_mask(__m512i(i1), __m512i(i0 + 1)) | wraps) == 0) {
       const V at = (p.row_shift >= 0 ? r << p.row_shift : r * p.row_width) + i0;
       load_row_pairs16(p.pairs, at, b0.p[0], b1.p[0], t0.p[0], t1.p[0]);
