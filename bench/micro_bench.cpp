@@ -69,6 +69,24 @@ void BM_VertexShader(benchmark::State& state) {
 }
 BENCHMARK(BM_VertexShader);
 
+// The same vertices through the shader's wide form at the CPU's level (vertex_simd.hpp), as draw
+// runs it.
+void BM_VertexShaderWide(benchmark::State& state) {
+  Mesh mesh = sphere_grid(16, 9, 32, 28);
+  detail::Lighting lighting;
+  lighting.light = glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f));
+  using Shader = detail::GouraudShader<false>;
+  Shader shader{{&mesh, glm::mat4(1.0f)}, glm::vec3(0.9f, 0.6f, 0.3f), lighting, 1.0f, {}};
+  std::vector<float> out(mesh.positions.size() * 7);
+  const detail::ShadeVerticesFn wide = detail::wide_shade_vertices<Shader>(simd_level());
+  for (auto _ : state) {
+    wide(&shader, nullptr, 0, uint32_t(mesh.positions.size()), out.data());
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(mesh.positions.size()));
+}
+BENCHMARK(BM_VertexShaderWide);
+
 std::vector<detail::WindowVertex> random_window_triangles(int count, float size, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> pos(0.0f, 1800.0f), d(-size, size);

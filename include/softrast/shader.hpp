@@ -33,7 +33,15 @@
 // A scalar shader is taken to discard (it returns a bool) and is always shaded immediately.
 //
 // The vertex shader pulls its own inputs by index (from whatever arrays the shader holds), so
-// any vertex layout works. Varyings are interpolated perspective-correctly.
+// any vertex layout works. Varyings are interpolated perspective-correctly. A shader may also
+// have a wide vertex shader, run on 16 vertices a call at the CPU's SIMD level:
+//   template <int N> SOFTRAST_SIMD_INLINE simd::Vec4<N> vertices(const Vertices<N>& v,
+//                                                               simd::Float<N>* varyings) const;
+// lane l is vertex v.index[l]; v.vec3(array) and the like read each lane's element of an array
+// (in one pass when the 16 are consecutive). It must compute what vertex() computes for each
+// lane (the built-in shaders do the same operations in the same order: the same bits). A shader
+// whose wide form covers only some of its settings says which draws take it with
+//   bool wide_vertices() const;
 #pragma once
 
 #include <algorithm>
@@ -49,6 +57,7 @@
 #include "softrast/detail/shade_block.hpp"
 #include "softrast/detail/shade_simd.hpp"
 #include "softrast/detail/texture_simd.hpp"
+#include "softrast/detail/vertex_simd.hpp"
 #include "softrast/framebuffer.hpp"
 #include "softrast/render_state.hpp"
 
@@ -90,6 +99,7 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
   // per shader type, as `clip` below.
   thread_local std::vector<uint32_t> names, renumbered;
   const uint32_t* name = nullptr;  // vertex k of this draw is the mesh's name[k] (null: k)
+  const uint32_t mesh_vertices = vertex_count;
   if (indices.size() < vertex_count) {
     detail::compact_draw(indices, vertex_count, names, renumbered);
     name = names.data();
@@ -101,8 +111,20 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
   thread_local std::vector<float> clip;
   if (clip.size() < size_t(vertex_count) * kStride) clip.resize(size_t(vertex_count) * kStride);
   float* const out = clip.data();  // the calling thread's buffer (workers have their own)
+  // A shader with a wide vertex shader runs it on 16 vertices a call (vertex_simd.hpp), where the
+  // indices fit its loads' 32-bit offsets.
+  detail::ShadeVerticesFn wide = nullptr;
+  if constexpr (detail::WideVertexShader<S>) {
+    if (mesh_vertices < (uint32_t(1) << 28) && detail::uses_wide_vertices(shader)) {
+      wide = detail::wide_shade_vertices<S>(simd_level());
+    }
+  }
   auto shade_vertices = [&](size_t job) {
     uint32_t end = uint32_t(std::min<size_t>(vertex_count, (job + 1) * kVerticesPerJob));
+    if (wide != nullptr) {
+      wide(&shader, name, uint32_t(job * kVerticesPerJob), end, out);
+      return;
+    }
     for (uint32_t i = uint32_t(job * kVerticesPerJob); i < end; ++i) {
       float* v = out + size_t(i) * kStride;
       glm::vec4 p = shader.vertex(name != nullptr ? name[i] : i, v + 4);

@@ -55,6 +55,35 @@ struct MeshInputs {
   glm::vec4 clip(uint32_t i) const { return mvp * glm::vec4(mesh->positions[i], 1.0f); }
   glm::vec2 uv(uint32_t i) const { return mesh->uvs[i] * uv_scale + uv_offset; }
   glm::vec3 position(uint32_t i) const { return mesh->positions[i] * position_scale; }
+
+  // The same for 16 vertices (a wide vertex shader's inputs), each the scalar function's
+  // operations in its order, so the same bits: glm's mat4 * vec4 is
+  // (m[0] x + m[1] y) + (m[2] z + m[3] 1).
+  template <int N>
+  SOFTRAST_SIMD_INLINE simd::Vec4<N> clip(const Vertices<N>& v) const {
+    using F = simd::Float<N>;
+    const simd::Vec3<N> p = v.vec3(mesh->positions.data());
+    simd::Vec4<N> c;
+    F* out[4] = {&c.x, &c.y, &c.z, &c.w};
+    for (int r = 0; r < 4; ++r) {
+      *out[r] =
+          (F(mvp[0][r]) * p.x + F(mvp[1][r]) * p.y) + (F(mvp[2][r]) * p.z + F(mvp[3][r] * 1.0f));
+    }
+    return c;
+  }
+  template <int N>
+  SOFTRAST_SIMD_INLINE simd::Vec2<N> uv(const Vertices<N>& v) const {
+    using F = simd::Float<N>;
+    const simd::Vec2<N> t = v.vec2(mesh->uvs.data());
+    return {t.x * F(uv_scale.x) + F(uv_offset.x), t.y * F(uv_scale.y) + F(uv_offset.y)};
+  }
+  template <int N>
+  SOFTRAST_SIMD_INLINE simd::Vec3<N> position(const Vertices<N>& v) const {
+    using F = simd::Float<N>;
+    const simd::Vec3<N> p = v.vec3(mesh->positions.data());
+    const F s(position_scale);
+    return {p.x * s, p.y * s, p.z * s};
+  }
 };
 
 // Samples at the uv in varyings (i, i + 1), with their derivatives when the filter needs them.
@@ -96,6 +125,10 @@ struct FlatShader {
   bool srgb = false;  // encode the output (the linear workflow)
   glm::vec4 vertex(uint32_t i, float*) const { return in.clip(i); }
   template <int N>
+  SOFTRAST_SIMD_INLINE simd::Vec4<N> vertices(const Vertices<N>& v, simd::Float<N>*) const {
+    return in.clip(v);
+  }
+  template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     if (f.opaque && !srgb) {  // one scalar pack instead of the fragment stage's 16-lane one
       f.set_rgba8(simd::Int<N>(int32_t(softrast::pack_rgba8(color))));
@@ -134,6 +167,29 @@ struct GouraudShader {
     }
     return in.clip(i);
   }
+  // vertex() on 16 vertices: glm's normalize (v times 1 / sqrt((x x + y y) + z z)), dot and
+  // std::max lane-wise, so the same bits. Vertex colours (decoded through std::pow) take vertex().
+  bool wide_vertices() const { return !colors.use; }
+  template <int N>
+  SOFTRAST_SIMD_INLINE simd::Vec4<N> vertices(const Vertices<N>& vs, simd::Float<N>* v) const {
+    using F = simd::Float<N>;
+    const simd::Vec3<N> m = vs.vec3(in.mesh->normals.data());
+    const F inv = F(1.0f) / simd::sqrt((m.x * m.x + m.y * m.y) + m.z * m.z);
+    const simd::Vec3<N> n = {m.x * inv, m.y * inv, m.z * inv};
+    lit_wide<N>(n, v);
+    if constexpr (kTwoSided) lit_wide<N>({-n.x, -n.y, -n.z}, v + 3);
+    return in.clip(vs);
+  }
+  // lit() with the material's albedo, to three varyings.
+  template <int N>
+  SOFTRAST_SIMD_INLINE void lit_wide(const simd::Vec3<N>& n, simd::Float<N>* v) const {
+    using F = simd::Float<N>;
+    const glm::vec3& l = lighting.light;
+    F d = (n.x * F(l.x) + n.y * F(l.y)) + n.z * F(l.z);
+    d = simd::select(d < F(0.0f), F(0.0f), d);  // std::max(d, 0.0f)
+    const F s = F(lighting.ambient) + F(lighting.diffuse) * d;
+    v[0] = F(albedo.r) * s, v[1] = F(albedo.g) * s, v[2] = F(albedo.b) * s;
+  }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
     int first = kTwoSided && !f.front_facing ? 3 : 0;
@@ -162,6 +218,12 @@ struct TextureShader {
     glm::vec2 uv = in.uv(i);
     v[0] = uv.x, v[1] = uv.y;
     return in.clip(i);
+  }
+  template <int N>
+  SOFTRAST_SIMD_INLINE simd::Vec4<N> vertices(const Vertices<N>& vs, simd::Float<N>* v) const {
+    const simd::Vec2<N> uv = in.uv(vs);
+    v[0] = uv.x, v[1] = uv.y;
+    return in.clip(vs);
   }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
@@ -256,6 +318,26 @@ struct PhongShader {
     }
     return in.clip(i);
   }
+  // vertex() on 16 vertices (copies and in.position's scale: the same bits); vertex colours
+  // (decoded through std::pow) take vertex().
+  bool wide_vertices() const { return !kColors; }
+  template <int N>
+  SOFTRAST_SIMD_INLINE simd::Vec4<N> vertices(const Vertices<N>& vs, simd::Float<N>* v) const {
+    if constexpr (!kColors) {
+      const simd::Vec3<N> p = in.position(vs);
+      const simd::Vec3<N> n = vs.vec3(in.mesh->normals.data());
+      v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = n.x, v[4] = n.y, v[5] = n.z;
+      if constexpr (kUv) {
+        const simd::Vec2<N> uv = in.uv(vs);
+        v[6] = uv.x, v[7] = uv.y;
+      }
+      if constexpr (kTangents) {
+        const simd::Vec4<N> t = vs.vec4(in.mesh->tangents.data());
+        v[8] = t.x, v[9] = t.y, v[10] = t.z, v[11] = t.w;
+      }
+    }
+    return in.clip(vs);
+  }
   // The unit shading normal: the interpolated one, or the normal map's; flipped on back faces
   // when lighting is two-sided.
   template <int N>
@@ -319,6 +401,12 @@ struct NormalsShader {
     const glm::vec3& n = in.mesh->normals[i];
     v[0] = n.x, v[1] = n.y, v[2] = n.z;
     return in.clip(i);
+  }
+  template <int N>
+  SOFTRAST_SIMD_INLINE simd::Vec4<N> vertices(const Vertices<N>& vs, simd::Float<N>* v) const {
+    const simd::Vec3<N> n = vs.vec3(in.mesh->normals.data());
+    v[0] = n.x, v[1] = n.y, v[2] = n.z;
+    return in.clip(vs);
   }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
