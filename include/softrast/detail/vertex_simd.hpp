@@ -13,6 +13,7 @@
 #include <concepts>
 #include <cstdint>
 #include <cstring>
+#include <utility>
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
@@ -37,83 +38,75 @@ struct Vertices {
   uint32_t first = 0;
 
   SOFTRAST_SIMD_INLINE simd::Vec2<N> vec2(const glm::vec2* array) const {
-    F v[2];
-    load<2>(reinterpret_cast<const float*>(array), v);
-    return {v[0], v[1]};
+    simd::Vec2<N> r;
+    load<2>(reinterpret_cast<const float*>(array), {&r.x, &r.y});
+    return r;
   }
   SOFTRAST_SIMD_INLINE simd::Vec3<N> vec3(const glm::vec3* array) const {
-    F v[3];
-    load<3>(reinterpret_cast<const float*>(array), v);
-    return {v[0], v[1], v[2]};
+    simd::Vec3<N> r;
+    load<3>(reinterpret_cast<const float*>(array), {&r.x, &r.y, &r.z});
+    return r;
   }
   SOFTRAST_SIMD_INLINE simd::Vec4<N> vec4(const glm::vec4* array) const {
-    F v[4];
-    load<4>(reinterpret_cast<const float*>(array), v);
-    return {v[0], v[1], v[2], v[3]};
+    simd::Vec4<N> r;
+    load<4>(reinterpret_cast<const float*>(array), {&r.x, &r.y, &r.z, &r.w});
+    return r;
   }
 
   // Element c of each lane's struct of kFloats floats, for c < kFloats.
+  // (Written through pointers to the caller's vectors, and the loads typed: arrays of vectors
+  // copied by value, and memcpy, GCC 12 moves 16 bytes at a time through the stack at AVX2,
+  // where each wider load of them then waits for the stores.)
   template <int kFloats>
-  SOFTRAST_SIMD_INLINE void load(const float* array, F (&out)[kFloats]) const {
-    static_assert(sizeof(F) == 16 * sizeof(float));
+  SOFTRAST_SIMD_INLINE void load(const float* array, F* const (&out)[kFloats]) const {
+    static_assert(kFloats >= 2 && kFloats <= 4);
     if (consecutive) {
-      // The 16 structs are 16 kFloats consecutive floats: loaded as kFloats vectors of 16 and
-      // sorted by shuffles (two per element for vec3; written for any width, so each level
-      // compiles them to its own permutes).
-      typedef float V __attribute__((vector_size(64)));
-      V a[kFloats];
-      std::memcpy(a, array + size_t(first) * kFloats, sizeof a);
-      V r[kFloats];
-      deinterleave(a, r);
-      for (int c = 0; c < kFloats; ++c) std::memcpy(&out[c], &r[c], sizeof(V));
+      // The structs of each native vector's lanes are kFloats consecutive vectors' worth of
+      // floats: loaded as such and sorted by shuffles of native vectors (two-source shuffles of
+      // the width the level has; at AVX2 and SSE, 16-lane shuffles were lowered lane by lane,
+      // which made the wide form slower than the scalar one).
+      using V = typename simd::Native<N>::F;
+      for (int part = 0; part < F::kParts; ++part) {
+        const float* from = array + (size_t(first) + size_t(part) * N) * kFloats;
+        V a[kFloats];
+        for (int k = 0; k < kFloats; ++k) {
+          a[k] = *reinterpret_cast<const typename simd::Native<N>::FU*>(from + k * N);
+        }
+        element<kFloats, 0>(a, out[0]->p[part], std::make_integer_sequence<int, N>{});
+        element<kFloats, 1>(a, out[1]->p[part], std::make_integer_sequence<int, N>{});
+        if constexpr (kFloats > 2) {
+          element<kFloats, 2>(a, out[2]->p[part], std::make_integer_sequence<int, N>{});
+        }
+        if constexpr (kFloats > 3) {
+          element<kFloats, 3>(a, out[3]->p[part], std::make_integer_sequence<int, N>{});
+        }
+      }
       return;
     }
     const I scaled = index * I(kFloats);
     for (int c = 0; c < kFloats; ++c) {
       const I bits = simd::gather(reinterpret_cast<const int32_t*>(array), scaled + I(c));
-      std::memcpy(&out[c], &bits, sizeof(F));
+      *out[c] = simd::bit_cast_float(bits);
     }
   }
 
  private:
-  template <class V>
-  SOFTRAST_SIMD_INLINE static void deinterleave(const V (&a)[2], V (&r)[2]) {
-    r[0] = __builtin_shufflevector(a[0], a[1], 0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26,
-                                   28, 30);
-    r[1] = __builtin_shufflevector(a[0], a[1], 1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27,
-                                   29, 31);
+  // Element c of lane l is float K l + c of the K vectors a[0..K-1] (a[j] holding floats j N to
+  // j N + N - 1): those of a[0] and a[1] by one shuffle, then each later vector's by a shuffle
+  // with the result so far.
+  static constexpr int source(int k, int c, int l) { return k * l + c; }
+  static constexpr int from_first_two(int k, int c, int l) {
+    return source(k, c, l) < 2 * N ? source(k, c, l) : 0;
   }
-  // Element c of struct l is float 3 l + c of the 48: those below 32 come from the first two
-  // vectors, the rest from the third.
-  template <class V>
-  SOFTRAST_SIMD_INLINE static void deinterleave(const V (&a)[3], V (&r)[3]) {
-    const V x =
-        __builtin_shufflevector(a[0], a[1], 0, 3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 0, 0, 0, 0, 0);
-    const V y =
-        __builtin_shufflevector(a[0], a[1], 1, 4, 7, 10, 13, 16, 19, 22, 25, 28, 31, 0, 0, 0, 0, 0);
-    const V z =
-        __builtin_shufflevector(a[0], a[1], 2, 5, 8, 11, 14, 17, 20, 23, 26, 29, 0, 0, 0, 0, 0, 0);
-    r[0] = __builtin_shufflevector(x, a[2], 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 17, 20, 23, 26, 29);
-    r[1] = __builtin_shufflevector(y, a[2], 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 18, 21, 24, 27, 30);
-    r[2] = __builtin_shufflevector(z, a[2], 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 16, 19, 22, 25, 28, 31);
+  static constexpr int from_vector(int k, int c, int j, int l) {
+    return source(k, c, l) / N == j ? N + source(k, c, l) - j * N : l;
   }
-  // Element c of struct l is float 4 l + c of the 64: every fourth of the first two vectors and
-  // of the last two, joined.
-  template <class V>
-  SOFTRAST_SIMD_INLINE static void deinterleave(const V (&a)[4], V (&r)[4]) {
-#define SOFTRAST_EVERY_FOURTH(v, w, c)                                                            \
-  __builtin_shufflevector(v, w, c, c + 4, c + 8, c + 12, c + 16, c + 20, c + 24, c + 28, 0, 0, 0, \
-                          0, 0, 0, 0, 0)
-#define SOFTRAST_ELEMENT(c)                                                                     \
-  __builtin_shufflevector(SOFTRAST_EVERY_FOURTH(a[0], a[1], c),                                 \
-                          SOFTRAST_EVERY_FOURTH(a[2], a[3], c), 0, 1, 2, 3, 4, 5, 6, 7, 16, 17, \
-                          18, 19, 20, 21, 22, 23)
-    r[0] = SOFTRAST_ELEMENT(0);
-    r[1] = SOFTRAST_ELEMENT(1);
-    r[2] = SOFTRAST_ELEMENT(2);
-    r[3] = SOFTRAST_ELEMENT(3);
-#undef SOFTRAST_ELEMENT
-#undef SOFTRAST_EVERY_FOURTH
+  template <int K, int c, class V, int... L>
+  SOFTRAST_SIMD_INLINE static void element(const V (&a)[K], V& r,
+                                           std::integer_sequence<int, L...>) {
+    r = __builtin_shufflevector(a[0], a[1], from_first_two(K, c, L)...);
+    if constexpr (K > 2) r = __builtin_shufflevector(r, a[2], from_vector(K, c, 2, L)...);
+    if constexpr (K > 3) r = __builtin_shufflevector(r, a[3], from_vector(K, c, 3, L)...);
   }
 };
 
