@@ -34,7 +34,8 @@
 //
 // The vertex shader pulls its own inputs by index (from whatever arrays the shader holds), so
 // any vertex layout works. Varyings are interpolated perspective-correctly. A shader may also
-// have a wide vertex shader, run on 16 vertices a call at the CPU's SIMD level:
+// have a wide vertex shader, run on 16 vertices a call where the CPU has AVX2 or AVX-512
+// (vertex() runs elsewhere):
 //   template <int N> SOFTRAST_SIMD_INLINE simd::Vec4<N> vertices(const Vertices<N>& v,
 //                                                               simd::Float<N>* varyings) const;
 // lane l is vertex v.index[l]; v.vec3(array) and the like read each lane's element of an array
