@@ -51,12 +51,16 @@ Mesh sphere_grid(int columns, int rows, int slices, int stacks) {
 }
 
 // The vertex stage: the built-in Gouraud vertex shader over a mesh's vertices.
-void BM_VertexShader(benchmark::State& state) {
-  Mesh mesh = sphere_grid(16, 9, 32, 28);
+// The vertex benchmarks' shader: Gouraud over a grid of spheres (137,808 vertices).
+detail::GouraudShader<false> bench_gouraud(const Mesh& mesh) {
   detail::Lighting lighting;
   lighting.light = glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f));
-  detail::GouraudShader<false> shader{
-      {&mesh, glm::mat4(1.0f)}, glm::vec3(0.9f, 0.6f, 0.3f), lighting, 1.0f, {}};
+  return {{&mesh, glm::mat4(1.0f)}, glm::vec3(0.9f, 0.6f, 0.3f), lighting, 1.0f, {}};
+}
+
+void BM_VertexShader(benchmark::State& state) {
+  Mesh mesh = sphere_grid(16, 9, 32, 28);
+  const detail::GouraudShader<false> shader = bench_gouraud(mesh);
   std::vector<float> out(mesh.positions.size() * 7);
   for (auto _ : state) {
     for (uint32_t i = 0; i < mesh.positions.size(); ++i) {
@@ -73,10 +77,8 @@ BENCHMARK(BM_VertexShader);
 // runs it.
 void BM_VertexShaderWide(benchmark::State& state) {
   Mesh mesh = sphere_grid(16, 9, 32, 28);
-  detail::Lighting lighting;
-  lighting.light = glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f));
   using Shader = detail::GouraudShader<false>;
-  Shader shader{{&mesh, glm::mat4(1.0f)}, glm::vec3(0.9f, 0.6f, 0.3f), lighting, 1.0f, {}};
+  const Shader shader = bench_gouraud(mesh);
   std::vector<float> out(mesh.positions.size() * 7);
   const detail::ShadeVerticesFn wide = detail::wide_shade_vertices<Shader>(simd_level());
   for (auto _ : state) {

@@ -17,6 +17,7 @@
 
 #include "softrast/shader.hpp"
 #include "softrast/simd_level.hpp"
+#include "test_util.hpp"
 
 namespace softrast {
 namespace {
@@ -158,18 +159,10 @@ void expect_within_one_unit(const Outcome& o, const std::string& what) {
   EXPECT_GT(o.float_beyond, 0);
 }
 
-std::vector<SimdLevel> levels_here() {
-  std::vector<SimdLevel> out;
-  for (SimdLevel l : {SimdLevel::kSse2, SimdLevel::kSse4, SimdLevel::kAvx2, SimdLevel::kAvx512}) {
-    if (l <= cpu_simd_level()) out.push_back(l);
-  }
-  return out;
-}
-
 TEST(DepthPrecision, SteepSliversWithinOneUnitOnEveryPathAndLevel) {
   std::vector<Tri> tris = slivers(3000, 7);
   SimdLevel saved = simd_level();
-  for (SimdLevel level : levels_here()) {
+  for (SimdLevel level : test::levels_of_this_cpu()) {
     set_simd_level(level);
     std::string at = std::string(" at ") + simd_level_name(level);
     RenderState deferred;  // opaque, depth less with writes, a shader that may be deferred

@@ -12,6 +12,7 @@
 #include "shaders/builtin_shaders.hpp"
 #include "softrast/renderer.hpp"
 #include "softrast/shader.hpp"
+#include "test_util.hpp"
 
 namespace softrast {
 namespace {
@@ -31,12 +32,6 @@ class GatherModeGuard {
   GatherMode saved_ = gather_mode(cpu_simd_level());
 };
 
-std::vector<SimdLevel> levels_of_this_cpu() {
-  std::vector<SimdLevel> levels;
-  for (int i = 0; i <= int(cpu_simd_level()); ++i) levels.push_back(SimdLevel(i));
-  return levels;
-}
-
 struct Rendered {
   Image image;
   std::vector<float> depth;
@@ -55,7 +50,7 @@ Rendered render_demo_at(SimdLevel level, const RenderOptions& options) {
 
 TEST(SimdLevel, NamesRoundTripAndCapIsHonoured) {
   SimdLevelGuard guard;
-  for (SimdLevel level : levels_of_this_cpu()) {
+  for (SimdLevel level : test::levels_of_this_cpu()) {
     EXPECT_EQ(parse_simd_level(simd_level_name(level)), level);
     set_simd_level(level);
     EXPECT_EQ(simd_level(), level);
@@ -71,7 +66,7 @@ TEST_P(SimdLevelGolden, EveryLevelGivesTheSameCoverageAndColoursWithinOne) {
   SimdLevelGuard guard;
   RenderOptions options;
   options.shader = GetParam();
-  std::vector<SimdLevel> levels = levels_of_this_cpu();
+  std::vector<SimdLevel> levels = test::levels_of_this_cpu();
   Rendered widest = render_demo_at(levels.back(), options);
   for (SimdLevel level : levels) {
     Rendered r = render_demo_at(level, options);
@@ -570,7 +565,7 @@ TEST(SimdGather, TexturedRendersAreTheSameWithEitherForm) {
   const auto pow2 = std::make_shared<Texture>(noise_texture(64, 64, 5));
   const auto odd = std::make_shared<Texture>(noise_texture(37, 19, 6));
   const auto srgb = std::make_shared<Texture>(noise_texture(32, 32, 7, true));
-  for (SimdLevel level : levels_of_this_cpu()) {
+  for (SimdLevel level : test::levels_of_this_cpu()) {
     if (level < SimdLevel::kAvx2) continue;
     for (ShaderKind kind : {ShaderKind::kTexture, ShaderKind::kPhong}) {
       for (Filter filter : {Filter::kBilinear, Filter::kTrilinear, Filter::kNearest}) {
@@ -630,7 +625,7 @@ TEST(SimdShader, DiscardingWideShaderEqualsItsScalarTwinAtEveryLevel) {
   state.cull = CullMode::kNone;
   Framebuffer want(97, 61);
   draw(want, state, HoleScalar{}, indices, 4);
-  for (SimdLevel level : levels_of_this_cpu()) {
+  for (SimdLevel level : test::levels_of_this_cpu()) {
     set_simd_level(level);
     Framebuffer got(97, 61);
     draw(got, state, HoleWide{}, indices, 4);
@@ -689,7 +684,7 @@ TEST(SimdShader, TinyInverseWIsGuardedAsTheScalarStageDoesAtEveryLevel) {
   EXPECT_EQ(red[1], red[2]);
   EXPECT_NEAR(red[3], 179, 1);
   GuardWide wide;
-  for (SimdLevel level : levels_of_this_cpu()) {
+  for (SimdLevel level : test::levels_of_this_cpu()) {
     Framebuffer whole(4, 4), shared(4, 4);
     whole.prepare_tile(0, 0);
     shared.prepare_tile(0, 0);
@@ -755,7 +750,7 @@ TEST(SimdShader, PackedOutputEqualsFloatOutputAtEveryLevel) {
       state.cull = CullMode::kNone;
       state.blend = blend;
       Sampler sampler{filter, Wrap::kRepeat, Wrap::kRepeat, false};
-      for (SimdLevel level : levels_of_this_cpu()) {
+      for (SimdLevel level : test::levels_of_this_cpu()) {
         set_simd_level(level);
         Framebuffer want(131, 77), got(131, 77);
         want.clear_color({0.2f, 0.4f, 0.6f, 1.0f});
@@ -808,7 +803,7 @@ TEST(SimdShader, BuiltInTextureShaderWritesBytesOnlyWhenOpaque) {
     RenderState state;
     state.cull = CullMode::kNone;
     state.blend = blend;
-    for (SimdLevel level : levels_of_this_cpu()) {
+    for (SimdLevel level : test::levels_of_this_cpu()) {
       set_simd_level(level);
       Framebuffer want(131, 77), got(131, 77);
       want.clear_color({0.2f, 0.4f, 0.6f, 1.0f});

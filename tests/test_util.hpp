@@ -28,6 +28,13 @@
 
 namespace softrast::test {
 
+// Every SIMD level this CPU runs, from SSE2 up to cpu_simd_level().
+inline std::vector<SimdLevel> levels_of_this_cpu() {
+  std::vector<SimdLevel> levels;
+  for (int i = 0; i <= int(cpu_simd_level()); ++i) levels.push_back(SimdLevel(i));
+  return levels;
+}
+
 // Names the raster algorithm in parameterised test names (BothRasterizers/Foo/Scanline).
 inline std::string algorithm_name(const testing::TestParamInfo<RasterAlgorithm>& info) {
   return info.param == RasterAlgorithm::kScanline ? "Scanline" : "EdgeEquations";

@@ -14,17 +14,10 @@
 
 #include "shaders/builtin_shaders.hpp"
 #include "softrast/simd_level.hpp"
+#include "test_util.hpp"
 
 namespace softrast {
 namespace {
-
-std::vector<SimdLevel> levels_of_this_cpu() {
-  std::vector<SimdLevel> levels;
-  for (SimdLevel l : {SimdLevel::kSse2, SimdLevel::kSse4, SimdLevel::kAvx2, SimdLevel::kAvx512}) {
-    if (int(l) <= int(cpu_simd_level())) levels.push_back(l);
-  }
-  return levels;
-}
 
 // A mesh whose every kind of value appears in several lanes of a group: vertex i's case is
 // i % 13, so the 16 lanes of each group see a different mix.
@@ -115,7 +108,7 @@ void expect_same_vertices(const S& shader, const std::string& what, uint32_t mes
       glm::vec4 p = shader.vertex(r.name != nullptr ? r.name[k] : k, v + 4);
       v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = p.w;
     }
-    for (SimdLevel level : levels_of_this_cpu()) {
+    for (SimdLevel level : test::levels_of_this_cpu()) {
       std::vector<float> got(floats, -7.0f);
       detail::wide_shade_vertices<S>(level)(&shader, r.name, r.begin, r.end, got.data());
       int differ = 0;
