@@ -61,8 +61,12 @@ struct MeshInputs {
   // (m[0] x + m[1] y) + (m[2] z + m[3] 1).
   template <int N>
   SOFTRAST_SIMD_INLINE simd::Vec4<N> clip(const Vertices<N>& v) const {
+    return clip<N>(v.vec3(mesh->positions.data()));
+  }
+  // ... of positions already read (the mesh's, unscaled).
+  template <int N>
+  SOFTRAST_SIMD_INLINE simd::Vec4<N> clip(const simd::Vec3<N>& p) const {
     using F = simd::Float<N>;
-    const simd::Vec3<N> p = v.vec3(mesh->positions.data());
     simd::Vec4<N> c;
     F* out[4] = {&c.x, &c.y, &c.z, &c.w};
     for (int r = 0; r < 4; ++r) {
@@ -77,10 +81,10 @@ struct MeshInputs {
     const simd::Vec2<N> t = v.vec2(mesh->uvs.data());
     return {t.x * F(uv_scale.x) + F(uv_offset.x), t.y * F(uv_scale.y) + F(uv_offset.y)};
   }
+  // position(i) of positions already read.
   template <int N>
-  SOFTRAST_SIMD_INLINE simd::Vec3<N> position(const Vertices<N>& v) const {
+  SOFTRAST_SIMD_INLINE simd::Vec3<N> position(const simd::Vec3<N>& p) const {
     using F = simd::Float<N>;
-    const simd::Vec3<N> p = v.vec3(mesh->positions.data());
     const F s(position_scale);
     return {p.x * s, p.y * s, p.z * s};
   }
@@ -323,8 +327,10 @@ struct PhongShader {
   bool wide_vertices() const { return !kColors; }
   template <int N>
   SOFTRAST_SIMD_INLINE simd::Vec4<N> vertices(const Vertices<N>& vs, simd::Float<N>* v) const {
+    // The positions read once, for the varyings and the clip position.
+    const simd::Vec3<N> mesh_p = vs.vec3(in.mesh->positions.data());
     if constexpr (!kColors) {
-      const simd::Vec3<N> p = in.position(vs);
+      const simd::Vec3<N> p = in.position(mesh_p);
       const simd::Vec3<N> n = vs.vec3(in.mesh->normals.data());
       v[0] = p.x, v[1] = p.y, v[2] = p.z, v[3] = n.x, v[4] = n.y, v[5] = n.z;
       if constexpr (kUv) {
@@ -336,7 +342,7 @@ struct PhongShader {
         v[8] = t.x, v[9] = t.y, v[10] = t.z, v[11] = t.w;
       }
     }
-    return in.clip(vs);
+    return in.clip(mesh_p);
   }
   // The unit shading normal: the interpolated one, or the normal map's; flipped on back faces
   // when lighting is two-sided.
