@@ -159,7 +159,9 @@ template <class T, class V>
   return DH(_mm512_cvtps_pd(__m256(v)));
 }
 [[gnu::always_inline]] inline DH half_double(IH v) {
-  return DH(_mm512_cvtepi32_pd(__m256i(v)));
+  // (The masked form: the unmasked one of GCC 12's header reads an undefined vector, which
+  // -Wuninitialized reports where it is inlined; GCC bug 105593.)
+  return DH(_mm512_maskz_cvtepi32_pd(__mmask8(0xff), __m256i(v)));
 }
 #else
 [[gnu::always_inline]] inline DH half_double(FH v) {
@@ -169,6 +171,34 @@ template <class T, class V>
   return DH(_mm256_cvtepi32_pd(__m128i(v)));
 }
 #endif
+
+// The lanes (as masks) where the area, given by halves, is negative and where it is not zero.
+[[gnu::always_inline]] inline void area_signs(const DH (&area)[2], I& negative, I& nonzero) {
+#if SOFTRAST_TRIANGLE_LANES == 16
+  const __m512d zero = _mm512_setzero_pd();
+  const __m512d low = __m512d(area[0]), high = __m512d(area[1]);
+  const unsigned below = _mm512_cmp_pd_mask(low, zero, _CMP_LT_OQ) |
+                         unsigned(_mm512_cmp_pd_mask(high, zero, _CMP_LT_OQ)) << 8;
+  const unsigned other = _mm512_cmp_pd_mask(low, zero, _CMP_NEQ_OQ) |
+                         unsigned(_mm512_cmp_pd_mask(high, zero, _CMP_NEQ_OQ)) << 8;
+  negative = I(_mm512_movm_epi32(__mmask16(below)));
+  nonzero = I(_mm512_movm_epi32(__mmask16(other)));
+#else
+  // The 64-bit masks' low halves in lane order: the first two of each 128-bit part of both
+  // halves, then the parts put in order.
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d low = __m256d(area[0]), high = __m256d(area[1]);
+  const __m256 below =
+      _mm256_shuffle_ps(_mm256_castpd_ps(_mm256_cmp_pd(low, zero, _CMP_LT_OQ)),
+                        _mm256_castpd_ps(_mm256_cmp_pd(high, zero, _CMP_LT_OQ)), 0x88);
+  const __m256 other =
+      _mm256_shuffle_ps(_mm256_castpd_ps(_mm256_cmp_pd(low, zero, _CMP_NEQ_OQ)),
+                        _mm256_castpd_ps(_mm256_cmp_pd(high, zero, _CMP_NEQ_OQ)), 0x88);
+  negative = I(_mm256_permute4x64_epi64(_mm256_castps_si256(below), 0xd8));
+  nonzero = I(_mm256_permute4x64_epi64(_mm256_castps_si256(other), 0xd8));
+#endif
+}
+
 // (Macros, not lambdas: GCC gives a lambda that returns a vector the default target's ABI.)
 #define SOFTRAST_HALF_FLOAT(v) __builtin_convertvector((v), FH)
 // Vertex k's float f (z, 1/w, x and y residual) for half h of the lanes, in double.
@@ -279,22 +309,19 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
   out.scalar = lane_bits(valid & ~accepted);
   x0 &= accepted, y0 &= accepted, x1 &= accepted, y1 &= accepted, x2 &= accepted, y2 &= accepted;
 
-  // signed_area_fx16, then is_culled (zero area is never kept).
-  const D area = SOFTRAST_TO_DOUBLE(x1 - x0) * SOFTRAST_TO_DOUBLE(y2 - y0) -
-                 SOFTRAST_TO_DOUBLE(x2 - x0) * SOFTRAST_TO_DOUBLE(y1 - y0);
-  // Its sign, half the lanes at a time (a compare of a vector of doubles two registers wide is
-  // compiled lane by lane).
-  I negative, nonzero;
-  {
-    alignas(64) int32_t negative_lanes[kL], nonzero_lanes[kL];
-    for (int h = 0; h < 2; ++h) {
-      const DH part = half<DH>(reinterpret_cast<const double*>(&area), h);
-      store_half(negative_lanes, h, __builtin_convertvector(part < 0.0, IH));
-      store_half(nonzero_lanes, h, __builtin_convertvector(part != 0.0, IH));
-    }
-    std::memcpy(&negative, negative_lanes, sizeof negative);
-    std::memcpy(&nonzero, nonzero_lanes, sizeof nonzero);
+  // signed_area_fx16, then is_culled (zero area is never kept): half the lanes at a time, each
+  // half one register of doubles, and the halves' signs joined in registers (through memory, the
+  // two halves' stores and the whole vector's load missed store forwarding: at AVX2 a sixth of
+  // the kernel's time stalled there).
+  const I ex1 = x1 - x0, ey1 = y1 - y0, ex2 = x2 - x0, ey2 = y2 - y0;
+  DH area[2];
+  for (int h = 0; h < 2; ++h) {
+#define SOFTRAST_PART(v) half_double(half<IH>(reinterpret_cast<const int32_t*>(&(v)), h))
+    area[h] = SOFTRAST_PART(ex1) * SOFTRAST_PART(ey2) - SOFTRAST_PART(ex2) * SOFTRAST_PART(ey1);
+#undef SOFTRAST_PART
   }
+  I negative, nonzero;
+  area_signs(area, negative, nonzero);
   const I front = nonzero & (b.front_face == FrontFace::kCounterClockwise ? negative : ~negative);
   I culled = I{};
   if (b.cull == CullMode::kBack) culled = ~front;
@@ -406,8 +433,9 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
   std::memcpy(out.bounds[1], &by0, sizeof by0);
   std::memcpy(out.bounds[2], &bx1, sizeof bx1);
   std::memcpy(out.bounds[3], &by1, sizeof by1);
-  const Q area_q = SOFTRAST_EXACT_INT64(area);
-  std::memcpy(out.area, &area_q, sizeof area_q);
+  for (int h = 0; h < 2; ++h) {
+    store_half(out.area, h, QH(area[h] + (DH{} + 0x1.8p52)) - QH(DH{} + 0x1.8p52));
+  }
   for (int k = 0; k < 3; ++k) {
     std::memcpy(out.vertex[k], &vi[k], sizeof vi[k]);
     std::memcpy(out.x[k], &vx[k], sizeof vx[k]);
