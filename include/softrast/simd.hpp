@@ -658,6 +658,16 @@ SOFTRAST_SIMD_INLINE void through_memory(int32_t (&at)[Lanes]) {
   }
 }
 
+// Asks the cache for base[at[lane] + ahead] for every fourth of `lanes` lanes (addresses formed
+// as integers: they may lie past the table, which a prefetch never faults on).
+inline void prefetch_every_fourth(const int32_t* base, const int32_t* at, int ahead,
+                                  int lanes = 16) {
+  const uintptr_t start = reinterpret_cast<uintptr_t>(base);
+  for (int lane = 0; lane < lanes; lane += 4) {
+    const uintptr_t element = uintptr_t(int64_t(at[lane]) + ahead);
+    _mm_prefetch(reinterpret_cast<const char*>(start + element * sizeof(int32_t)), _MM_HINT_T0);
+  }
+}
 // The 64-bit pairs base[index[i]], base[index[i] + 1] of every lane, in lane order: at 8 lanes
 // a holds lanes 0 to 3, c the rest (gather_pair below sorts them into lo and hi).
 [[gnu::target("avx2")]] inline void pairs_instruction(const int32_t* base,
@@ -670,9 +680,11 @@ SOFTRAST_SIMD_INLINE void through_memory(int32_t (&at)[Lanes]) {
 }
 [[gnu::target("avx2")]] inline void pairs_loads(const int32_t* base, const Native<8>::I& index,
                                                 __m256i& a, __m256i& c,
-                                                IndexRoute route = IndexRoute::kMemory) {
+                                                IndexRoute route = IndexRoute::kMemory,
+                                                int ahead = 0) {
   alignas(32) int32_t at[8];
   index_lanes(index, route, at);
+  if (ahead != 0) prefetch_every_fourth(base, at, ahead, 8);
   a = join(load_pairs2(base, at), load_pairs2(base, at + 2));
   c = join(load_pairs2(base, at + 4), load_pairs2(base, at + 6));
 }
@@ -695,15 +707,6 @@ SOFTRAST_SIMD_INLINE void through_memory(int32_t (&at)[Lanes]) {
   const __m512i odd = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27, 29, 31);
   lo = _mm512_permutex2var_epi32(a, even, c);
   hi = _mm512_permutex2var_epi32(a, odd, c);
-}
-// Asks the cache for base[at[lane] + ahead] for lanes 0, 4, 8 and 12 (addresses formed as
-// integers: they may lie past the table, which a prefetch never faults on).
-inline void prefetch_every_fourth(const int32_t* base, const int32_t* at, int ahead) {
-  const uintptr_t start = reinterpret_cast<uintptr_t>(base);
-  for (int lane = 0; lane < 16; lane += 4) {
-    const uintptr_t element = uintptr_t(int64_t(at[lane]) + ahead);
-    _mm_prefetch(reinterpret_cast<const char*>(start + element * sizeof(int32_t)), _MM_HINT_T0);
-  }
 }
 // The pairs sorted into lo and hi four lanes at a time, as they arrive (two unpacks), and then
 // joined: a shorter way from the loads to lo and hi than joining the pairs whole and sorting them
@@ -795,13 +798,16 @@ inline void gather_pair(const int32_t* base, const Native<4>::I& index, Native<4
     hi[i] = v[1];
   }
 }
+// `ahead` (not 0): with one load per lane, also prefetch_every_fourth (the texture sampler's
+// rows read on to the right).
 [[gnu::target("avx2")]] inline void gather_pair(const int32_t* base, const Native<8>::I& index,
                                                 Native<8>::I& lo, Native<8>::I& hi,
-                                                IndexRoute route = IndexRoute::kMemory) {
+                                                IndexRoute route = IndexRoute::kMemory,
+                                                int ahead = 0) {
   // a = l0 h0 l1 h1 | l2 h2 l3 h3, c = l4 h4 l5 h5 | l6 h6 l7 h7 (32-bit elements)
   __m256i ai, ci;
   if (loads_for_gathers<8>()) {
-    pairs_loads(base, index, ai, ci, route);
+    pairs_loads(base, index, ai, ci, route, ahead);
   } else {
     pairs_instruction(base, index, ai, ci);
   }
@@ -904,12 +910,18 @@ SOFTRAST_SIMD_INLINE Float<N> lookup16(const float* table, const Int<N>& index) 
   return r;
 }
 
-// Lane i of lo = base[index[i]], of hi = base[index[i] + 1]; both must be valid.
+// Lane i of lo = base[index[i]], of hi = base[index[i] + 1]; both must be valid. `ahead`, at 8
+// lanes: isa::gather_pair's (the 16-lane kernels call theirs directly).
 template <int N>
 SOFTRAST_SIMD_INLINE void gather_pair(const int32_t* base, const Int<N>& index, Int<N>& lo,
-                                      Int<N>& hi, IndexRoute route = IndexRoute::kMemory) {
+                                      Int<N>& hi, IndexRoute route = IndexRoute::kMemory,
+                                      int ahead = 0) {
   for (int k = 0; k < Int<N>::kParts; ++k) {
-    isa::gather_pair(base, index.p[k], lo.p[k], hi.p[k], route);
+    if constexpr (N == 8) {
+      isa::gather_pair(base, index.p[k], lo.p[k], hi.p[k], route, ahead);
+    } else {
+      isa::gather_pair(base, index.p[k], lo.p[k], hi.p[k], route);
+    }
   }
 }
 

@@ -196,6 +196,16 @@ SOFTRAST_SIMD_INLINE simd::Int<N> filter_rgba8_packed(
   return (((red_blue + round) >> 7) & bytes) | (((green_alpha + round) << 1) & odd_bytes);
 }
 
+// How far along its texel row the sampler asks the cache for texels beyond each of a block's
+// rows, where it reads each row's two texels with one 64-bit load (simd::gather_pair's `ahead`,
+// on both rows of the filter, from every fourth lane). A triangle's blocks come left to right, so
+// its next blocks read on along those rows, and where the texture outgrows the L2 cache
+// (quad_grid's 1024x1024, read over several repeats) their lines would come from L3 while a block
+// waits. 32 texels (two lines) measured faster than 16 and 64 at AVX-512 (the same as 16 and
+// faster than 64 at AVX2, where it made quad_grid texture 12 % faster); aiming at the next
+// block's own texels (from the block's change across its row) measured no faster than none.
+inline constexpr int kTexelsAhead = 32;
+
 // The common bilinear sample at AVX-512, inlined into the 16-lane shaders: the base level of an
 // RGBA8 texture without sRGB decode, each axis clamped to the edge or repeated over a power-of-two
 // size. The arithmetic is sample_level's, the same operations in the same order (so the same
@@ -236,14 +246,6 @@ SOFTRAST_AVX512_SAMPLER __m512i wrap_clamp_or_repeat16(bool repeat, __m512i i, i
   return __m512i(x & last);
 }
 
-// How far along its texel row the sampler's common case asks the cache for texels beyond each
-// of a block's four rows (simd::isa::gather_pair's `ahead`, on both rows of the filter: eight
-// lines). A triangle's blocks come left to right, so its next blocks read on along those rows,
-// and where the texture outgrows the L2 cache (quad_grid's 1024x1024, read over several repeats)
-// their lines would come from L3 while a block waits. 32 texels (two lines) measured faster than
-// 16 and 64; aiming at the next block's own texels (from the block's change across its row)
-// measured no faster than none.
-inline constexpr int kTexelsAhead = 32;
 // The same for the row pairs, in pairs (eight to a line): as many lines ahead.
 inline constexpr int kPairsAhead = 16;
 
@@ -406,9 +408,10 @@ SOFTRAST_SIMD_INLINE void bilinear_texels(const Texture& t, const Sampler& s,
   const auto* texels = reinterpret_cast<const int32_t*>(t.texels());
   if (simd::bits(i1 == i0 + one) == 0xffffu) {
     // No lane wraps between its two columns: texels (i0, j) and (i1, j) are neighbours in memory,
-    // so one 64-bit load per lane and row fetches both (the same texels, half the loads).
-    simd::gather_pair<N>(texels, offset + j0 * w + i0, b0, b1, kTexelRoute);
-    simd::gather_pair<N>(texels, offset + j1 * w + i0, t0, t1, kTexelRoute);
+    // so one 64-bit load per lane and row fetches both (the same texels, half the loads), and
+    // the rows' texels further right are asked for (at AVX2).
+    simd::gather_pair<N>(texels, offset + j0 * w + i0, b0, b1, kTexelRoute, kTexelsAhead);
+    simd::gather_pair<N>(texels, offset + j1 * w + i0, t0, t1, kTexelRoute, kTexelsAhead);
     return;
   }
   b0 = simd::gather<N>(texels, offset + j0 * w + i0, kTexelRoute);
