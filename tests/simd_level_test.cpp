@@ -423,7 +423,7 @@ TEST(SimdSampler, MatchesScalarSamplingBitForBitAtEveryLevel) {
   for (int i = 0; i < 1024; ++i) uvs.push_back({near_range(rng), near_range(rng)});
   for (int i = 0; i < 256; ++i) uvs.push_back({far_range(rng), far_range(rng)});
   // Columns inside the texture and rows across its bottom and top edges: whole groups of lanes
-  // whose columns are neighbours even when clamped (the AVX-512 sampler's row pairs,
+  // whose columns are neighbours even when clamped (the AVX2 and AVX-512 samplers' row pairs,
   // Texture::row_pairs), with rows below the first, on the first and last, and above the last.
   std::uniform_real_distribution<float> inside(0.05f, 0.95f), across(-0.1f, 1.1f);
   for (int i = 0; i < 512; ++i) uvs.push_back({inside(rng), across(rng)});

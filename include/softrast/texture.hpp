@@ -73,11 +73,12 @@ inline float fast_log2(float x) {
 // (j + 0.5) / height) in (u, v); j = 0 is the bottom row of the picture. Channels are read as
 // linear values in [0, 1].
 // Whether textures bound for a draw keep a copy of their texels in row pairs (Texture::row_pairs,
-// row_pair_chain) for the AVX-512 sampler: bilinear and trilinear sampling faster (quad_grid
-// texture about 13 %), for twice the texture's memory (three times with its mip chain), built at
-// its first draw. On by default. A program that draws each texture once (one image) saves that
-// time and memory by turning it off: the command line's `render` does when it draws one image.
-// Not to be changed while a draw is running on another thread.
+// row_pair_chain) for the AVX2 and AVX-512 samplers: bilinear and trilinear sampling faster
+// (quad_grid texture about 13 % at AVX-512, 4 % at AVX2), for twice the texture's memory (three
+// times with its mip chain), built at its first draw. On by default. A program that draws each
+// texture once (one image) saves that time and memory by turning it off: the command line's
+// `render` does when it draws one image. Not to be changed while a draw is running on another
+// thread.
 void set_texture_row_pairs(bool on);
 bool texture_row_pairs();
 
@@ -164,10 +165,10 @@ class Texture {
   // first use and kept: the built-in shaders ask it in every frame.
   bool translucent() const;
 
-  // The base level's texels in vertical pairs, for the AVX-512 sampler's bilinear loads: element
-  // (i, j) is the 64-bit pair of texels (i, clamp(j)) and (i, clamp(j + 1)), rows clamped to the
-  // edge, for j from -1 (the returned pointer's row 0 is j = 0; row -1 lies before it). So one
-  // 128-bit load at (i, j) holds all four texels a bilinear sample of rows j and j + 1 and
+  // The base level's texels in vertical pairs, for the AVX2 and AVX-512 samplers' bilinear loads:
+  // element (i, j) is the 64-bit pair of texels (i, clamp(j)) and (i, clamp(j + 1)), rows clamped
+  // to the edge, for j from -1 (the returned pointer's row 0 is j = 0; row -1 lies before it). So
+  // one 128-bit load at (i, j) holds all four texels a bilinear sample of rows j and j + 1 and
   // columns i and i + 1 reads. Built once (safe from several threads at once) when the texture
   // is first bound for a draw (SampledTexture), so draws after the first allocate nothing. Null
   // before that, with set_texture_row_pairs(false), for an empty texture and above
@@ -286,9 +287,9 @@ class Texture {
 };
 
 namespace detail {
-// What the AVX-512 sampler's common case needs of a texture and its sampler: the base level of an
-// RGBA8 texture without sRGB decode, filtered bilinearly, each axis clamped to the edge or
-// repeated over a power-of-two size. `texels` is null where the case does not apply.
+// What the AVX2 and AVX-512 samplers' common case needs of a texture and its sampler: the base
+// level of an RGBA8 texture without sRGB decode, filtered bilinearly, each axis clamped to the edge
+// or repeated over a power-of-two size. `texels` is null where the case does not apply.
 struct BilinearPlan {
   const int32_t* texels = nullptr;
   float width = 0.0f, height = 0.0f;  // the base level's size, as floats
@@ -297,7 +298,7 @@ struct BilinearPlan {
   int32_t row_width = 0;                    // texels per row
   int row_shift = -1;                       // log2(row_width) for a power of two, else -1
   // Texture::row_pairs(), set by SampledTexture's constructor where the sampler reads texels by
-  // loads (gather_mode kLoads) at AVX-512; else null: of() leaves it so, and the gather
+  // loads (gather_mode kLoads) at AVX2 or AVX-512; else null: of() leaves it so, and the gather
   // instruction reads the rows as they are.
   const int64_t* pairs = nullptr;
 
@@ -339,8 +340,9 @@ class SampledTexture {
     if (texture.mips_ && texture.mips_->bindings.load(std::memory_order_relaxed) < (1 << 30)) {
       texture.mips_->bindings.fetch_add(1, std::memory_order_relaxed);
     }
-    if (bilinear_.texels != nullptr && simd_level() == SimdLevel::kAvx512 &&
-        gather_mode(SimdLevel::kAvx512) == GatherMode::kLoads) {
+    if (bilinear_.texels != nullptr &&
+        (simd_level() == SimdLevel::kAvx512 || simd_level() == SimdLevel::kAvx2) &&
+        gather_mode(simd_level()) == GatherMode::kLoads) {
       bilinear_.pairs = reinterpret_cast<const int64_t*>(texture.row_pairs());
     }
   }

@@ -60,6 +60,28 @@ SOFTRAST_SIMD_INLINE void sample_rgba8_lanes(const Texture& texture, const Sampl
   sample_rgba8_lanes<8>(texture, s, io);
 }
 
+[[gnu::target("avx2"), gnu::flatten]] void sample_plan_8(const BilinearPlan& plan,
+                                                         SampleLanes& io) {
+  using F = simd::Float<8>;
+  simd::Int<8> b0, b1, t0, t1;
+  F fx, fy;
+  plan_texels<8>(plan, {F::load(io.in[0]), F::load(io.in[1])}, b0, b1, t0, t1, fx, fy);
+  const simd::Vec4<8> c = filter_rgba8<8>(b0, b1, t0, t1, fx, fy);
+  c.x.store(io.out[0]);
+  c.y.store(io.out[1]);
+  c.z.store(io.out[2]);
+  c.w.store(io.out[3]);
+}
+
+[[gnu::target("avx2"), gnu::flatten]] void sample_rgba8_plan_8(const BilinearPlan& plan,
+                                                               SampleLanes& io) {
+  using F = simd::Float<8>;
+  simd::Int<8> b0, b1, t0, t1;
+  F fx, fy;
+  plan_texels<8>(plan, {F::load(io.in[0]), F::load(io.in[1])}, b0, b1, t0, t1, fx, fy);
+  filter_rgba8_packed<8>(b0, b1, t0, t1, fx, fy).store(io.rgba8);
+}
+
 [[gnu::flatten]] void sample_lanes_4(const Texture& texture, const Sampler& s, SampleLanes& io,
                                      bool derivatives) {
   sample_lanes<4>(texture, s, io, derivatives);

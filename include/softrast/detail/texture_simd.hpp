@@ -205,6 +205,8 @@ SOFTRAST_SIMD_INLINE simd::Int<N> filter_rgba8_packed(
 // faster than 64 at AVX2, where it made quad_grid texture 12 % faster); aiming at the next
 // block's own texels (from the block's change across its row) measured no faster than none.
 inline constexpr int kTexelsAhead = 32;
+// The same for the row pairs, in pairs (eight to a line): as many lines ahead.
+inline constexpr int kPairsAhead = 16;
 
 // The common bilinear sample at AVX-512, inlined into the 16-lane shaders: the base level of an
 // RGBA8 texture without sRGB decode, each axis clamped to the edge or repeated over a power-of-two
@@ -245,9 +247,6 @@ SOFTRAST_AVX512_SAMPLER __m512i wrap_clamp_or_repeat16(bool repeat, __m512i i, i
   }
   return __m512i(x & last);
 }
-
-// The same for the row pairs, in pairs (eight to a line): as many lines ahead.
-inline constexpr int kPairsAhead = 16;
 
 // The four texels of each lane from its rows' first texels and its two columns: one 64-bit load
 // per lane and row where no lane wraps between its columns (sample_level), else four gathers.
@@ -368,6 +367,100 @@ SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const BilinearPlan& p, const simd
 #undef SOFTRAST_AVX512_SAMPLER
 
 }  // namespace avx512
+
+// The row pairs (Texture::row_pairs) of 8 lanes at AVX2, as load_row_pairs16 reads 16: one
+// 128-bit load per lane at its pair `at` holds b0, t0, b1 and t1, and a 4x4 transpose within each
+// 128-bit part sorts them (part c of vector m gathers lane 4c + m); the pairs kPairsAhead on from
+// every fourth lane are asked for.
+[[gnu::target("avx2")]] inline void load_row_pairs8(const int64_t* pairs,
+                                                    const simd::Native<8>::I& at,
+                                                    simd::Native<8>::I& b0, simd::Native<8>::I& b1,
+                                                    simd::Native<8>::I& t0,
+                                                    simd::Native<8>::I& t1) {
+  alignas(32) int32_t lane[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(lane), __m256i(at));
+  // (Addresses formed as integers: they may lie past the table, which a prefetch never faults on.)
+  const uintptr_t start = reinterpret_cast<uintptr_t>(pairs);
+  for (int l = 0; l < 8; l += 4) {
+    const uintptr_t ahead = uintptr_t(int64_t(lane[l]) + kPairsAhead) * sizeof(int64_t);
+    _mm_prefetch(reinterpret_cast<const char*>(start + ahead), _MM_HINT_T0);
+  }
+  auto quad = [&](int l) {
+    return _mm_loadu_si128(reinterpret_cast<const __m128i*>(pairs + lane[l]));
+  };
+  __m256i m[4];
+  for (int k = 0; k < 4; ++k) {
+    m[k] = _mm256_inserti128_si256(_mm256_castsi128_si256(quad(k)), quad(k + 4), 1);
+  }
+  const __m256i a = _mm256_unpacklo_epi32(m[0], m[1]), b = _mm256_unpackhi_epi32(m[0], m[1]);
+  const __m256i c = _mm256_unpacklo_epi32(m[2], m[3]), d = _mm256_unpackhi_epi32(m[2], m[3]);
+  b0 = simd::Native<8>::I(_mm256_unpacklo_epi64(a, c));
+  t0 = simd::Native<8>::I(_mm256_unpackhi_epi64(a, c));
+  b1 = simd::Native<8>::I(_mm256_unpacklo_epi64(b, d));
+  t1 = simd::Native<8>::I(_mm256_unpackhi_epi64(b, d));
+}
+
+// wrap_texel for a plan's two modes (`last`: the size minus one, a power of two minus one when
+// repeating).
+template <int N>
+SOFTRAST_SIMD_INLINE void wrap_plan(bool repeat, const simd::Int<N>& i, int last,
+                                    simd::Int<N>& out) {
+  using I = simd::Int<N>;
+  out = repeat ? i & I(last) : simd::select(i < I(0), I(0), simd::select(i > I(last), I(last), i));
+}
+
+// bilinear_texels for a BilinearPlan's case at AVX2 (8 lanes a register): the same texels and
+// fractions, by the same operations; the rows by a shift where the width is a power of two, and
+// from the row pairs (when the plan has them) where every lane's columns are neighbours and no
+// repeated row wraps, as avx512::bilinear_texels16 reads them.
+template <int N>
+SOFTRAST_SIMD_INLINE void plan_texels(const BilinearPlan& p, const simd::Vec2<N>& uv,
+                                      simd::Int<N>& b0, simd::Int<N>& b1, simd::Int<N>& t0,
+                                      simd::Int<N>& t1, simd::Float<N>& fx, simd::Float<N>& fy) {
+  static_assert(N == 8);
+  using F = simd::Float<N>;
+  using I = simd::Int<N>;
+  const I x0 = texel_floor<N>(uv.x * F(p.width) - F(0.5f), fx);
+  const I y0 = texel_floor<N>(uv.y * F(p.height) - F(0.5f), fy);
+  const I one(1);
+  I i0, i1;
+  wrap_plan<N>(p.repeat_u, x0, p.last_u, i0);
+  wrap_plan<N>(p.repeat_u, x0 + one, p.last_u, i1);
+  const I neighbours = i1 == i0 + one;
+  if (p.pairs != nullptr) {
+    // The row pair of each lane's lower row (avx512::pair_row16).
+    const I last(p.last_v);
+    I r, wraps(0);
+    if (p.repeat_v) {
+      r = y0 & last;
+      wraps = r == last;
+    } else {
+      r = simd::select(y0 < I(-1), I(-1), y0);
+      r = simd::select(r > last, last, r);
+    }
+    if (simd::bits(neighbours & ~wraps) == 0xffffu) {
+      const I at = (p.row_shift >= 0 ? r << p.row_shift : r * I(p.row_width)) + i0;
+      for (int k = 0; k < I::kParts; ++k) {
+        load_row_pairs8(p.pairs, at.p[k], b0.p[k], b1.p[k], t0.p[k], t1.p[k]);
+      }
+      return;
+    }
+  }
+  I j0, j1;
+  wrap_plan<N>(p.repeat_v, y0, p.last_v, j0);
+  wrap_plan<N>(p.repeat_v, y0 + one, p.last_v, j1);
+  const I row0 = p.row_shift >= 0 ? j0 << p.row_shift : j0 * I(p.row_width);
+  const I row1 = p.row_shift >= 0 ? j1 << p.row_shift : j1 * I(p.row_width);
+  if (simd::bits(neighbours) == 0xffffu) {
+    simd::gather_pair<N>(p.texels, row0 + i0, b0, b1, kTexelRoute, kTexelsAhead);
+    simd::gather_pair<N>(p.texels, row1 + i0, t0, t1, kTexelRoute, kTexelsAhead);
+    return;
+  }
+  b0 = simd::gather<N>(p.texels, row0 + i0, kTexelRoute);
+  b1 = simd::gather<N>(p.texels, row0 + i1, kTexelRoute);
+  t0 = simd::gather<N>(p.texels, row1 + i0, kTexelRoute);
+  t1 = simd::gather<N>(p.texels, row1 + i1, kTexelRoute);
+}
 
 // Texel (i, j) of the level whose size and first texel are (w, h, offset), lane by lane.
 template <int N>
@@ -561,12 +654,17 @@ struct SampleLanes {
 // too), 8 needs AVX2 and 16 AVX-512, which is what the shader's level has. (The one exception is
 // avx512::bilinear_texels16 above, the common case at the widest level, inlined: without the
 // call's spills and the lanes' trip through memory, quad_grid texture and phong ran 4 and 6 %
-// faster.)
+// faster. At AVX2 the same case has kernels of its own, sample_plan_8 and sample_rgba8_plan_8,
+// which read the row pairs: inlined there, with 16 vector registers, the shader's values spilled
+// around the sample.)
 void sample_lanes_4(const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives);
 void sample_lanes_8(const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives);
 void sample_lanes_16(const Texture& texture, const Sampler& s, SampleLanes& io, bool derivatives);
 // The same without derivatives, packed as RGBA8 into io.rgba8 (sample_rgba8).
 void sample_rgba8_lanes_4(const Texture& texture, const Sampler& s, SampleLanes& io);
+// At AVX2, a BilinearPlan's case (plan_texels): channels into io.out, or packed into io.rgba8.
+void sample_plan_8(const BilinearPlan& plan, SampleLanes& io);
+void sample_rgba8_plan_8(const BilinearPlan& plan, SampleLanes& io);
 void sample_rgba8_lanes_8(const Texture& texture, const Sampler& s, SampleLanes& io);
 void sample_rgba8_lanes_16(const Texture& texture, const Sampler& s, SampleLanes& io);
 
@@ -605,6 +703,12 @@ SOFTRAST_SIMD_INLINE simd::Vec4<N> sample(const SampledTexture& t, const simd::V
   detail::SampleLanes io;
   uv.x.store(io.in[0]);
   uv.y.store(io.in[1]);
+  if constexpr (N == 8) {
+    if (const detail::BilinearPlan* plan = t.bilinear()) {  // the common case, out of line
+      detail::sample_plan_8(*plan, io);
+      return {F::load(io.out[0]), F::load(io.out[1]), F::load(io.out[2]), F::load(io.out[3])};
+    }
+  }
   return detail::sample_out_of_line<N>(t.texture(), t.sampler(), io, false);
 }
 
@@ -633,6 +737,12 @@ SOFTRAST_SIMD_INLINE simd::Int<N> sample_rgba8(const SampledTexture& t, const si
   detail::SampleLanes io;
   uv.x.store(io.in[0]);
   uv.y.store(io.in[1]);
+  if constexpr (N == 8) {
+    if (const detail::BilinearPlan* plan = t.bilinear()) {  // the common case, out of line
+      detail::sample_rgba8_plan_8(*plan, io);
+      return simd::Int<N>::load(io.rgba8);
+    }
+  }
   if constexpr (N == 4) {
     detail::sample_rgba8_lanes_4(t.texture(), t.sampler(), io);
   } else if constexpr (N == 8) {
