@@ -172,15 +172,16 @@ template <class T, class V>
 }
 #endif
 
-// The lanes (as masks) where the area, given by halves, is negative and where it is not zero.
+// The lanes (as masks) where the area, given by halves, is negative and where it is not zero
+// (`< 0.0` and `!= 0.0` of C++: the unordered not-equal, although an area is never NaN).
 [[gnu::always_inline]] inline void area_signs(const DH (&area)[2], I& negative, I& nonzero) {
 #if SOFTRAST_TRIANGLE_LANES == 16
   const __m512d zero = _mm512_setzero_pd();
   const __m512d low = __m512d(area[0]), high = __m512d(area[1]);
   const unsigned below = _mm512_cmp_pd_mask(low, zero, _CMP_LT_OQ) |
                          unsigned(_mm512_cmp_pd_mask(high, zero, _CMP_LT_OQ)) << 8;
-  const unsigned other = _mm512_cmp_pd_mask(low, zero, _CMP_NEQ_OQ) |
-                         unsigned(_mm512_cmp_pd_mask(high, zero, _CMP_NEQ_OQ)) << 8;
+  const unsigned other = _mm512_cmp_pd_mask(low, zero, _CMP_NEQ_UQ) |
+                         unsigned(_mm512_cmp_pd_mask(high, zero, _CMP_NEQ_UQ)) << 8;
   negative = I(_mm512_movm_epi32(__mmask16(below)));
   nonzero = I(_mm512_movm_epi32(__mmask16(other)));
 #else
@@ -192,8 +193,8 @@ template <class T, class V>
       _mm256_shuffle_ps(_mm256_castpd_ps(_mm256_cmp_pd(low, zero, _CMP_LT_OQ)),
                         _mm256_castpd_ps(_mm256_cmp_pd(high, zero, _CMP_LT_OQ)), 0x88);
   const __m256 other =
-      _mm256_shuffle_ps(_mm256_castpd_ps(_mm256_cmp_pd(low, zero, _CMP_NEQ_OQ)),
-                        _mm256_castpd_ps(_mm256_cmp_pd(high, zero, _CMP_NEQ_OQ)), 0x88);
+      _mm256_shuffle_ps(_mm256_castpd_ps(_mm256_cmp_pd(low, zero, _CMP_NEQ_UQ)),
+                        _mm256_castpd_ps(_mm256_cmp_pd(high, zero, _CMP_NEQ_UQ)), 0x88);
   negative = I(_mm256_permute4x64_epi64(_mm256_castps_si256(below), 0xd8));
   nonzero = I(_mm256_permute4x64_epi64(_mm256_castps_si256(other), 0xd8));
 #endif
@@ -433,7 +434,7 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
   std::memcpy(out.bounds[1], &by0, sizeof by0);
   std::memcpy(out.bounds[2], &bx1, sizeof bx1);
   std::memcpy(out.bounds[3], &by1, sizeof by1);
-  for (int h = 0; h < 2; ++h) {
+  for (int h = 0; h < 2; ++h) {  // SOFTRAST_EXACT_INT64 half by half
     store_half(out.area, h, QH(area[h] + (DH{} + 0x1.8p52)) - QH(DH{} + 0x1.8p52));
   }
   for (int k = 0; k < 3; ++k) {
