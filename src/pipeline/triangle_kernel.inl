@@ -281,6 +281,32 @@ template <class T, class V>
 #undef SOFTRAST_HALF_FLOAT
 #undef SOFTRAST_FIELD
 
+// Corner k's (x, y) of every lane, read at the vertex the index buffer names (p: the group's
+// indices, three per lane, every one valid): one 64-bit load per lane, the pairs sorted into x
+// and y four lanes at a time (as simd::isa::pairs_loads sorts them). Straight from the indices,
+// without the index vectors' trip through the stack that the gather takes.
+[[gnu::always_inline]] inline void corner_xy(const int32_t* base, const uint32_t* p, int k, I& x,
+                                             I& y) {
+  auto pair = [&](int l) {
+    return _mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + size_t(p[3 * l + k]) * 6));
+  };
+  __m128i low4[kL / 4], high4[kL / 4];
+  for (int g = 0; g < kL / 4; ++g) {
+    const __m128i p01 = _mm_unpacklo_epi32(pair(4 * g), pair(4 * g + 1));      // x0 x1 y0 y1
+    const __m128i p23 = _mm_unpacklo_epi32(pair(4 * g + 2), pair(4 * g + 3));  // x2 x3 y2 y3
+    low4[g] = _mm_unpacklo_epi64(p01, p23);
+    high4[g] = _mm_unpackhi_epi64(p01, p23);
+  }
+#if SOFTRAST_TRIANGLE_LANES == 16
+  using simd::isa::join;
+  x = I(join(join(low4[0], low4[1]), join(low4[2], low4[3])));
+  y = I(join(join(high4[0], high4[1]), join(high4[2], high4[3])));
+#else
+  x = I(simd::isa::join(low4[0], low4[1]));
+  y = I(simd::isa::join(high4[0], high4[1]));
+#endif
+}
+
 void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLanes& out) {
   const uint32_t* p = b.indices + 3 * first;
   alignas(64) uint32_t tail[3 * kL];
@@ -301,9 +327,15 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
   const auto* base = reinterpret_cast<const int32_t*>(b.window);
   static_assert(sizeof(PackedVertex) == 6 * sizeof(int32_t));
   I x0, y0, x1, y1, x2, y2;
-  simd::isa::gather_pair(base, i0 * 6, x0, y0);
-  simd::isa::gather_pair(base, i1 * 6, x1, y1);
-  simd::isa::gather_pair(base, i2 * 6, x2, y2);
+  if (lane_bits(valid) == (1u << kL) - 1 && simd::loads_for_gathers<kL>()) {
+    corner_xy(base, p, 0, x0, y0);
+    corner_xy(base, p, 1, x1, y1);
+    corner_xy(base, p, 2, x2, y2);
+  } else {
+    simd::isa::gather_pair(base, i0 * 6, x0, y0);
+    simd::isa::gather_pair(base, i1 * 6, x1, y1);
+    simd::isa::gather_pair(base, i2 * 6, x2, y2);
+  }
   // WindowVertices::triangle: every code 0 is the trivial accept; the rest is the scalar path's.
   const I accepted =
       valid & (x0 != kOutsideVolume) & (x1 != kOutsideVolume) & (x2 != kOutsideVolume);
