@@ -208,6 +208,16 @@ inline constexpr int kTexelsAhead = 32;
 // The same for the row pairs, in pairs (eight to a line): as many lines ahead.
 inline constexpr int kPairsAhead = 16;
 
+// Asks the cache for the pairs kPairsAhead on from every fourth of `lanes` lanes' pair `lane[l]`
+// (addresses formed as integers: they may lie past the table, which a prefetch never faults on).
+inline void prefetch_pairs_ahead(const int64_t* pairs, const int32_t* lane, int lanes) {
+  const uintptr_t start = reinterpret_cast<uintptr_t>(pairs);
+  for (int l = 0; l < lanes; l += 4) {
+    const uintptr_t ahead = uintptr_t(int64_t(lane[l]) + kPairsAhead) * sizeof(int64_t);
+    _mm_prefetch(reinterpret_cast<const char*>(start + ahead), _MM_HINT_T0);
+  }
+}
+
 // The common bilinear sample at AVX-512, inlined into the 16-lane shaders: the base level of an
 // RGBA8 texture without sRGB decode, each axis clamped to the edge or repeated over a power-of-two
 // size. The arithmetic is sample_level's, the same operations in the same order (so the same
@@ -294,12 +304,7 @@ SOFTRAST_AVX512_SAMPLER void load_row_pairs16(const int64_t* pairs, const simd::
                                               simd::Native<16>::I& t0, simd::Native<16>::I& t1) {
   alignas(64) int32_t lane[16];
   _mm512_store_si512(lane, __m512i(at));
-  // (Addresses formed as integers: they may lie past the table, which a prefetch never faults on.)
-  const uintptr_t start = reinterpret_cast<uintptr_t>(pairs);
-  for (int l = 0; l < 16; l += 4) {
-    const uintptr_t ahead = uintptr_t(int64_t(lane[l]) + kPairsAhead) * sizeof(int64_t);
-    _mm_prefetch(reinterpret_cast<const char*>(start + ahead), _MM_HINT_T0);
-  }
+  prefetch_pairs_ahead(pairs, lane, 16);
   auto quad = [&](int l) {
     return _mm_loadu_si128(reinterpret_cast<const __m128i*>(pairs + lane[l]));
   };
@@ -379,12 +384,7 @@ SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const BilinearPlan& p, const simd
                                                     simd::Native<8>::I& t1) {
   alignas(32) int32_t lane[8];
   _mm256_store_si256(reinterpret_cast<__m256i*>(lane), __m256i(at));
-  // (Addresses formed as integers: they may lie past the table, which a prefetch never faults on.)
-  const uintptr_t start = reinterpret_cast<uintptr_t>(pairs);
-  for (int l = 0; l < 8; l += 4) {
-    const uintptr_t ahead = uintptr_t(int64_t(lane[l]) + kPairsAhead) * sizeof(int64_t);
-    _mm_prefetch(reinterpret_cast<const char*>(start + ahead), _MM_HINT_T0);
-  }
+  prefetch_pairs_ahead(pairs, lane, 8);
   auto quad = [&](int l) {
     return _mm_loadu_si128(reinterpret_cast<const __m128i*>(pairs + lane[l]));
   };
@@ -398,15 +398,6 @@ SOFTRAST_AVX512_SAMPLER void bilinear_texels16(const BilinearPlan& p, const simd
   t0 = simd::Native<8>::I(_mm256_unpackhi_epi64(a, c));
   b1 = simd::Native<8>::I(_mm256_unpacklo_epi64(b, d));
   t1 = simd::Native<8>::I(_mm256_unpackhi_epi64(b, d));
-}
-
-// wrap_texel for a plan's two modes (`last`: the size minus one, a power of two minus one when
-// repeating).
-template <int N>
-SOFTRAST_SIMD_INLINE void wrap_plan(bool repeat, const simd::Int<N>& i, int last,
-                                    simd::Int<N>& out) {
-  using I = simd::Int<N>;
-  out = repeat ? i & I(last) : simd::select(i < I(0), I(0), simd::select(i > I(last), I(last), i));
 }
 
 // bilinear_texels for a BilinearPlan's case at AVX2 (8 lanes a register): the same texels and
@@ -423,9 +414,12 @@ SOFTRAST_SIMD_INLINE void plan_texels(const BilinearPlan& p, const simd::Vec2<N>
   const I x0 = texel_floor<N>(uv.x * F(p.width) - F(0.5f), fx);
   const I y0 = texel_floor<N>(uv.y * F(p.height) - F(0.5f), fy);
   const I one(1);
-  I i0, i1;
-  wrap_plan<N>(p.repeat_u, x0, p.last_u, i0);
-  wrap_plan<N>(p.repeat_u, x0 + one, p.last_u, i1);
+  // The plan's modes are wrap_texel's clamp and power-of-two repeat.
+  const Wrap wrap_u = p.repeat_u ? Wrap::kRepeat : Wrap::kClampToEdge;
+  const Wrap wrap_v = p.repeat_v ? Wrap::kRepeat : Wrap::kClampToEdge;
+  const I width(p.last_u + 1), height(p.last_v + 1);
+  const I i0 = wrap_texel<N>(wrap_u, x0, width, true);
+  const I i1 = wrap_texel<N>(wrap_u, x0 + one, width, true);
   const I neighbours = i1 == i0 + one;
   if (p.pairs != nullptr) {
     // The row pair of each lane's lower row (avx512::pair_row16).
@@ -446,9 +440,8 @@ SOFTRAST_SIMD_INLINE void plan_texels(const BilinearPlan& p, const simd::Vec2<N>
       return;
     }
   }
-  I j0, j1;
-  wrap_plan<N>(p.repeat_v, y0, p.last_v, j0);
-  wrap_plan<N>(p.repeat_v, y0 + one, p.last_v, j1);
+  const I j0 = wrap_texel<N>(wrap_v, y0, height, true);
+  const I j1 = wrap_texel<N>(wrap_v, y0 + one, height, true);
   const I row0 = p.row_shift >= 0 ? j0 << p.row_shift : j0 * I(p.row_width);
   const I row1 = p.row_shift >= 0 ? j1 << p.row_shift : j1 * I(p.row_width);
   if (simd::bits(neighbours) == 0xffffu) {
