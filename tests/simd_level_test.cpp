@@ -384,6 +384,48 @@ template <>
   return depth_plane_mismatches_impl<16>(cases);
 }
 
+// The highlight's x^32 (pow32, five squarings) makes no denormal: a base below kPow32Floor gives
+// 0, one above it the five squarings' own result. And the floor changes no 8-bit colour: for
+// every base below it, Phong's colour fma(albedo, lit, ks * x^32) packs to the same byte with the
+// power (denormal or not, as the squarings make it) as with 0, for every albedo byte, lights from
+// none to the brightest --light-intensity allows (specular 0.4 * 100).
+TEST(SimdShadingMath, Pow32MakesNoDenormalAndItsFloorChangesNoColour) {
+  auto squarings = [](float x) {
+    for (int k = 0; k < 5; ++k) x = x * x;
+    return x;
+  };
+  auto pack = [](float v) { return int(std::min(std::max(v, 0.0f), 1.0f) * 255.0f + 0.5f); };
+  std::vector<float> below;
+  for (int i = 0; i <= 400000; ++i) {
+    const float x = float(i) / 400000.0f;
+    simd::Float<4> r = detail::pow32<4>(simd::Float<4>(x));
+    const float power = r.lane(0);
+    ASSERT_TRUE(power == 0.0f || power >= std::numeric_limits<float>::min()) << x;
+    if (x >= detail::kPow32Floor) {
+      ASSERT_EQ(power, squarings(x)) << x;
+    } else {
+      ASSERT_EQ(power, 0.0f) << x;
+      below.push_back(x);
+    }
+  }
+  ASSERT_GT(below.size(), 20000u);
+  int checked = 0;
+  for (size_t b = 0; b < below.size(); b += 97) {
+    const float power = squarings(below[b]);
+    for (int albedo = 0; albedo <= 255; ++albedo) {
+      for (float lit : {0.0f, 0.15f, 1.0f, 100.0f}) {
+        for (float ks : {0.4f, 4.0f, 40.0f}) {
+          const float a = float(albedo) / 255.0f;
+          ASSERT_EQ(pack(std::fma(a, lit, ks * power)), pack(std::fma(a, lit, ks * 0.0f)))
+              << below[b] << " " << albedo << " " << lit << " " << ks;
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 100000);
+}
+
 // The fragment stage's depth is the scalar plane's, bit for bit, at every level: the tile kernels'
 // depth resolve computes the same double sum, and deferred shading is exact only if the two agree.
 // Half the planes nearly cancel at one pixel, so that a change of the operations' order (a
