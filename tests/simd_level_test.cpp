@@ -386,9 +386,9 @@ template <>
 
 // The highlight's x^32 (pow32, five squarings) makes no denormal: a base below kPow32Floor gives
 // 0, one above it the five squarings' own result. And the floor changes no 8-bit colour: for
-// every base below it, Phong's colour fma(albedo, lit, ks * x^32) packs to the same byte with the
-// power (denormal or not, as the squarings make it) as with 0, for every albedo byte, lights from
-// none to the brightest --light-intensity allows (specular 0.4 * 100).
+// every base below it, Phong's colour albedo * lit + ks * x^32 (fused or not) packs to the same
+// byte with the power (denormal or not, as the squarings make it) as with 0, for every albedo byte,
+// lights from none to the brightest --light-intensity allows (specular 0.4 * 100).
 TEST(SimdShadingMath, Pow32MakesNoDenormalAndItsFloorChangesNoColour) {
   auto squarings = [](float x) {
     for (int k = 0; k < 5; ++k) x = x * x;
@@ -416,7 +416,10 @@ TEST(SimdShadingMath, Pow32MakesNoDenormalAndItsFloorChangesNoColour) {
       for (float lit : {0.0f, 0.15f, 1.0f, 100.0f}) {
         for (float ks : {0.4f, 4.0f, 40.0f}) {
           const float a = float(albedo) / 255.0f;
+          // Fused where the level has FMA, a product and a sum at SSE (simd::fma).
           ASSERT_EQ(pack(std::fma(a, lit, ks * power)), pack(std::fma(a, lit, ks * 0.0f)))
+              << below[b] << " " << albedo << " " << lit << " " << ks;
+          ASSERT_EQ(pack(a * lit + ks * power), pack(a * lit + ks * 0.0f))
               << below[b] << " " << albedo << " " << lit << " " << ks;
           ++checked;
         }
