@@ -659,13 +659,14 @@ SOFTRAST_SIMD_INLINE void through_memory(int32_t (&at)[Lanes]) {
 }
 
 // Asks the cache for base[at[lane] + ahead] for every fourth of `lanes` lanes (addresses formed
-// as integers: they may lie past the table, which a prefetch never faults on).
-inline void prefetch_every_fourth(const int32_t* base, const int32_t* at, int ahead,
-                                  int lanes = 16) {
+// as integers: they may lie past the table, which a prefetch never faults on). T: the table's
+// element (the texels, or the row pairs of texture_simd.hpp).
+template <class T>
+inline void prefetch_every_fourth(const T* base, const int32_t* at, int ahead, int lanes = 16) {
   const uintptr_t start = reinterpret_cast<uintptr_t>(base);
   for (int lane = 0; lane < lanes; lane += 4) {
     const uintptr_t element = uintptr_t(int64_t(at[lane]) + ahead);
-    _mm_prefetch(reinterpret_cast<const char*>(start + element * sizeof(int32_t)), _MM_HINT_T0);
+    _mm_prefetch(reinterpret_cast<const char*>(start + element * sizeof(T)), _MM_HINT_T0);
   }
 }
 // The 64-bit pairs base[index[i]], base[index[i] + 1] of every lane, in lane order: at 8 lanes

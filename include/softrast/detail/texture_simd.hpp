@@ -208,14 +208,9 @@ inline constexpr int kTexelsAhead = 32;
 // The same for the row pairs, in pairs (eight to a line): as many lines ahead.
 inline constexpr int kPairsAhead = 16;
 
-// Asks the cache for the pairs kPairsAhead on from every fourth of `lanes` lanes' pair `lane[l]`
-// (addresses formed as integers: they may lie past the table, which a prefetch never faults on).
+// Asks the cache for the pairs kPairsAhead on from every fourth of `lanes` lanes' pair `lane[l]`.
 inline void prefetch_pairs_ahead(const int64_t* pairs, const int32_t* lane, int lanes) {
-  const uintptr_t start = reinterpret_cast<uintptr_t>(pairs);
-  for (int l = 0; l < lanes; l += 4) {
-    const uintptr_t ahead = uintptr_t(int64_t(lane[l]) + kPairsAhead) * sizeof(int64_t);
-    _mm_prefetch(reinterpret_cast<const char*>(start + ahead), _MM_HINT_T0);
-  }
+  simd::isa::prefetch_every_fourth(pairs, lane, kPairsAhead, lanes);
 }
 
 // The common bilinear sample at AVX-512, inlined into the 16-lane shaders: the base level of an
