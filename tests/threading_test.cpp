@@ -3,9 +3,15 @@
 // order-dependent blending across batches.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <mutex>
 #include <random>
+#include <thread>
 #include <vector>
 
+#include "softrast/detail/parallel.hpp"
 #include "softrast/renderer.hpp"
 #include "softrast/shader.hpp"
 
@@ -106,6 +112,33 @@ TEST(Threading, DemoSceneIsIdenticalForEveryThreadCount) {
       EXPECT_TRUE(images[i] == images[0]) << shader_kind_name(kind) << " run " << i;
     }
   }
+}
+
+// parallel_slot, which the binned draw hands its jobs out by: every thread of a parallel_for has
+// a place below its thread count, no two threads share one, the calling thread's is 0, and a
+// thread keeps its place from one parallel_for to the next.
+TEST(Threading, ParallelSlotIsAStablePlacePerThread) {
+  const int threads = std::min(4, detail::hardware_threads());
+  EXPECT_EQ(detail::parallel_slot(), 0);
+  std::mutex mutex;
+  std::map<std::thread::id, int> place_of;
+  std::map<int, std::thread::id> thread_at;
+  for (int round = 0; round < 50; ++round) {
+    detail::parallel_for(64, threads, [&](size_t) {
+      const int place = detail::parallel_slot();
+      // Long enough that the pool's workers join in.
+      std::this_thread::sleep_for(std::chrono::microseconds(20));
+      std::lock_guard lock(mutex);
+      EXPECT_GE(place, 0);
+      EXPECT_LT(place, threads);
+      auto [it, added] = place_of.emplace(std::this_thread::get_id(), place);
+      EXPECT_EQ(it->second, place) << "a thread changed its place";
+      auto [at, new_place] = thread_at.emplace(place, std::this_thread::get_id());
+      EXPECT_EQ(at->second, std::this_thread::get_id()) << "two threads share place " << place;
+    });
+  }
+  EXPECT_EQ(place_of[std::this_thread::get_id()], 0);
+  if (threads > 1) EXPECT_GT(place_of.size(), 1u) << "the pool's workers never ran";
 }
 
 }  // namespace

@@ -71,6 +71,13 @@ struct alignas(64) Chunk {
   std::vector<std::vector<uint32_t>> bins;  // per tile: offsets of its records in `records`
   // Per tile (deferrable draws): the area of its records' bounding boxes clipped to it.
   std::vector<int64_t> box_area;
+  size_t place = 0;  // the thread that set it up (parallel_slot)
+};
+
+// A thread place's next jobs in a phase (BinnedDraw::run_phase), on a cache line of its own.
+struct alignas(64) PlaceCounters {
+  std::atomic<size_t> chunk{0};  // its next chunk: place + this times the places
+  std::atomic<size_t> tile{0};   // its next tile in DrawCache::place_tiles
 };
 
 // A tile worker's scratch for the draws that may defer (deferred tiles, and the batch of the
@@ -88,6 +95,11 @@ struct DrawCache {
   std::vector<std::unique_ptr<DeferredScratch>> scratch;  // per tile worker
   // (~bit width of the tile's record count, tile): the busiest class first, in tile order
   std::vector<std::pair<uint32_t, uint32_t>> tile_order;
+  // Per thread place (run_phase): the tiles it takes first, busiest first, and its counters.
+  std::vector<std::vector<uint32_t>> place_tiles;
+  std::vector<size_t> place_records;  // scratch: a tile's records set up by each place
+  std::unique_ptr<PlaceCounters[]> counters;
+  size_t num_counters = 0;
 };
 
 DrawCache& draw_cache() {
@@ -397,8 +409,14 @@ class BinnedDraw {
   }
 
   // One parallel phase: the chunks of `setup` (phase 1), then, when `raster`, the tiles of the
-  // batch in raster_chunks_ (phase 2). Workers take jobs in that order until none is left: the
-  // chunks first, then the tiles with the most records. Each worker has its own scratch in the
+  // batch in raster_chunks_ (phase 2). Each job has a place (parallel_slot, a thread that keeps
+  // it from phase to phase): chunk k the place k modulo the workers, a tile the place that set
+  // up most of its records. A worker takes its own place's chunks, then any chunk left, then its
+  // own tiles, then any tile left, until none is left; the tiles of each place busiest first.
+  // So most records are read by the thread that wrote them, from its own cache, and a chunk's
+  // arena is rewritten by the thread that wrote it last (with every job taken by whoever came
+  // first, the record writes and reads that crossed between the threads made spheres_1m phong
+  // 4 % and quad_grid texture 2 % slower at two threads). Each worker has its own scratch in the
   // cache (not one per thread), so what is allocated does not depend on which thread ran which
   // tile.
   void run_phase(const SetupJobs& setup, bool raster) {
@@ -418,28 +436,73 @@ class BinnedDraw {
         if (cache_.scratch[w]->interps.size() < records) cache_.scratch[w]->interps.resize(records);
       }
     }
-    std::atomic<size_t> next{0};
+    place_jobs(workers);
+    const std::vector<std::vector<uint32_t>>& tiles = cache_.place_tiles;
+    PlaceCounters* counters = cache_.counters.get();
+    constexpr size_t kNone = SIZE_MAX;
+    // The next job for place `me`: below setup_jobs a chunk, else setup_jobs + a tile.
+    auto take = [&](size_t me) {
+      for (size_t i = 0, p = me; i < workers; ++i, p = p + 1 == workers ? 0 : p + 1) {
+        size_t k = p + workers * counters[p].chunk.fetch_add(1, std::memory_order_relaxed);
+        if (k < setup_jobs) return k;
+      }
+      for (size_t i = 0, p = me; i < workers; ++i, p = p + 1 == workers ? 0 : p + 1) {
+        size_t j = counters[p].tile.fetch_add(1, std::memory_order_relaxed);
+        if (j < tiles[p].size()) return setup_jobs + tiles[p][j];
+      }
+      return kNone;
+    };
     parallel_for(workers, threads_, [&](size_t worker) {
+      const size_t me = size_t(parallel_slot()) % workers;
       // Each worker takes its next job before doing the current one, so that a next tile's
       // framebuffer lines are on their way while this one is drawn (a pair per block drawn, the
       // rest at the end).
       TilePrefetch ahead;
-      size_t following = next.fetch_add(1);
-      for (size_t k = following; k < jobs; k = following) {
-        following = next.fetch_add(1);
+      size_t following = take(me);
+      for (size_t k = following; k != kNone; k = following) {
+        following = take(me);
         if (k < setup_jobs) {
           size_t begin = std::min(setup.first + setup.count, setup.first + k * setup.per_chunk);
           size_t end = std::min(setup.first + setup.count, begin + setup.per_chunk);
+          setup.chunks[k].place = me;
           setup_chunk(setup.chunks[k], setup.indices, begin, end);
           continue;
         }
-        ahead = following >= setup_jobs && following < jobs
-                    ? tile_prefetch(order[following - setup_jobs].second)
+        ahead = following != kNone && following >= setup_jobs
+                    ? tile_prefetch(following - setup_jobs)
                     : TilePrefetch{};
-        raster_tile_job(order[k - setup_jobs].second, worker, ahead);
+        raster_tile_job(k - setup_jobs, worker, ahead);
         ahead.rest();
       }
     });
+  }
+
+  // The phase's tiles (cache_.tile_order) by place, into cache_.place_tiles, and the places'
+  // counters at 0. The cache keeps the capacity of both.
+  void place_jobs(size_t workers) {
+    std::vector<std::vector<uint32_t>>& tiles = cache_.place_tiles;
+    if (tiles.size() < workers) tiles.resize(workers);
+    for (size_t p = 0; p < workers; ++p) tiles[p].clear();
+    if (cache_.num_counters < workers) {
+      cache_.counters = std::make_unique<PlaceCounters[]>(workers);
+      cache_.num_counters = workers;
+    }
+    for (size_t p = 0; p < workers; ++p) {
+      cache_.counters[p].chunk.store(0, std::memory_order_relaxed);
+      cache_.counters[p].tile.store(0, std::memory_order_relaxed);
+    }
+    std::vector<size_t>& records = cache_.place_records;
+    records.resize(workers);
+    for (const auto& [busy, tile] : cache_.tile_order) {
+      size_t owner = 0;
+      if (workers > 1) {
+        std::fill(records.begin(), records.end(), 0);
+        for (const Chunk& chunk : chunks())
+          records[chunk.place % workers] += chunk.bins[tile].size();
+        owner = size_t(std::max_element(records.begin(), records.end()) - records.begin());
+      }
+      tiles[owner].push_back(tile);
+    }
   }
 
   // The tiles the batch in raster_chunks_ touches, into cache_.tile_order. With several workers

@@ -17,6 +17,12 @@ int hardware_threads();
 void parallel_for(size_t count, int max_threads, void (*fn)(void* context, size_t index),
                   void* context);
 
+// The calling thread's place among the threads of a parallel_for: 0 for the thread that calls it,
+// k for the pool's k-th worker (parallel_for with max_threads T runs on places 0 to T - 1). A
+// thread keeps its place for the life of the process, so work handed out by place meets the same
+// thread, and the same cache, from one parallel_for to the next.
+int parallel_slot();
+
 template <class F>
 void parallel_for(size_t count, int max_threads, F&& f) {
   using Fn = std::remove_reference_t<F>;
