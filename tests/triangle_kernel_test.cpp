@@ -322,6 +322,156 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
   EXPECT_GT(checked_blocks, 1000 * levels);
 }
 
+// The kernel in the steps the binned draw gathers with (AVX-512): each group's select, its ready
+// lanes appended to a gathering group (at any offset, in pieces when they do not fit, into a
+// group that starts as garbage), then that group's finish; a group with a lane for the scalar
+// path ends the gathering. Every ready lane must equal its lane of the one-step kernel (fn),
+// field for field and bit for bit, planes included, in submission order.
+TEST(TriangleKernel, GatheredGroupsEqualTheWholeGroups) {
+  const int kVertices = 3000;
+  std::vector<float> data = kernel_vertices(kVertices, 23);
+  detail::ClipVertices clip{data.data(), size_t(kVertices), 4 + kKernelVaryings, kKernelVaryings};
+  RenderState state;
+  detail::GeometryStage geometry(1920, 1080, state, clip);
+  // Triangles of nearby vertices inside the clip volume, and one in 300 with a vertex outside it
+  // (the scalar path's, which ends a gathering).
+  std::vector<uint32_t> inside, outside;
+  for (uint32_t i = 0; i < uint32_t(kVertices); ++i) {
+    (geometry.vertex_code(i) == 0 ? inside : outside).push_back(i);
+  }
+  ASSERT_GT(inside.size(), 1000u);
+  ASSERT_GT(outside.size(), 10u);
+  std::mt19937 rng(9);
+  std::vector<uint32_t> indices;
+  const int kTriangles = 6000;
+  for (int t = 0; t < kTriangles; ++t) {
+    size_t base = rng() % (inside.size() - 8);
+    for (int k = 0; k < 3; ++k) indices.push_back(inside[base + rng() % 8]);
+    if (t % 300 == 7) indices.back() = outside[rng() % outside.size()];
+  }
+  auto same = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  int gathered_groups = 0, compared = 0, scalar_groups = 0, lower_blocks = 0, levels = 0;
+  for (SimdLevel level : {SimdLevel::kAvx2, SimdLevel::kAvx512}) {
+    if (cpu_simd_level() < level) continue;
+    const detail::TriangleKernel kernel = detail::triangle_kernel(level);
+    if (kernel.append == nullptr) continue;  // no gathering at this level
+    ++levels;
+    detail::WindowVertices vertices;
+    vertices.transform(geometry, 1);
+    for (CullMode cull : {CullMode::kBack, CullMode::kNone}) {
+      detail::TriangleBatch batch;
+      batch.indices = indices.data();
+      batch.vertex_count = vertices.size();
+      batch.window = vertices.window();
+      batch.cull = cull;
+      batch.scissor = geometry.scissor();
+      batch.varyings = geometry.varyings(0);
+      batch.stride = geometry.stride();
+      batch.num_varyings = geometry.num_varyings();
+      const int width = kernel.lanes;
+      // The one-step kernel's ready lanes, in submission order, and the gathered ones.
+      std::vector<std::pair<const detail::TriangleLanes*, int>> want, got;
+      std::vector<std::unique_ptr<detail::TriangleLanes>> keep;
+      // A gathering group starts as garbage but for its vertex indices (finish reads the
+      // vertices of every lane), so that a field append does not copy cannot match by chance.
+      auto fresh = [] {
+        auto g = std::make_unique<detail::TriangleLanes>();
+        std::memset(static_cast<void*>(g.get()), 0xa5, sizeof *g);
+        std::memset(g->vertex, 0, sizeof g->vertex);
+        g->ready = 0;
+        return g;
+      };
+      auto gathering = fresh();
+      int filled = 0;
+      auto flush = [&] {
+        if (filled == 0) return;
+        EXPECT_EQ(gathering->ready, (1u << filled) - 1u);
+        kernel.finish(batch, *gathering);
+        for (int l = 0; l < filled; ++l) got.emplace_back(gathering.get(), l);
+        keep.push_back(std::move(gathering));
+        gathering = fresh();
+        filled = 0;
+        ++gathered_groups;
+      };
+      for (size_t first = 0; first < size_t(kTriangles); first += size_t(width)) {
+        const int count = int(std::min<size_t>(size_t(width), kTriangles - first));
+        auto whole = std::make_unique<detail::TriangleLanes>();
+        kernel.fn(batch, first, count, *whole);
+        for (uint32_t m = whole->ready; m != 0; m &= m - 1) {
+          want.emplace_back(whole.get(), __builtin_ctz(m));
+        }
+        keep.push_back(std::move(whole));
+        auto part_owner = std::make_unique<detail::TriangleLanes>();
+        detail::TriangleLanes& part = *part_owner;
+        kernel.select(batch, first, count, part);
+        if (part.scalar != 0) {
+          // A lane for the scalar path (a vertex outside the volume) ends the gathering, as in
+          // the draw: what is gathered goes first, then this group whole.
+          flush();
+          kernel.finish(batch, part);
+          for (uint32_t m = part.ready; m != 0; m &= m - 1)
+            got.emplace_back(&part, __builtin_ctz(m));
+          keep.push_back(std::move(part_owner));
+          ++scalar_groups;
+          continue;
+        }
+        // Into the gathering group in two pieces where they fit, else as many as fit, a flush
+        // and the rest: offsets 0 to width - 1 all occur.
+        uint32_t todo = part.ready;
+        while (todo != 0) {
+          const int room = width - filled;
+          const int take = std::min({room, 1 + int(first % 3), __builtin_popcount(todo)});
+          uint32_t piece = 0;  // the first `take` lanes of todo
+          for (uint32_t m = todo; __builtin_popcount(piece) < take; m &= m - 1)
+            piece |= m & (~m + 1);
+          const int taken = take;
+          kernel.append(part, piece, *gathering, filled);
+          filled += taken;
+          todo &= ~piece;
+          if (filled == width) flush();
+        }
+      }
+      flush();
+      ASSERT_EQ(got.size(), want.size());
+      for (size_t i = 0; i < got.size(); ++i) {
+        const detail::TriangleLanes& g = *got[i].first;
+        const detail::TriangleLanes& w = *want[i].first;
+        const int a = got[i].second, b = want[i].second;
+        SCOPED_TRACE(::testing::Message() << "level " << int(level) << " ready lane " << i);
+        for (int k = 0; k < 3; ++k) {
+          EXPECT_EQ(g.vertex[k][a], w.vertex[k][b]);
+          EXPECT_EQ(g.x[k][a], w.x[k][b]);
+          EXPECT_EQ(g.y[k][a], w.y[k][b]);
+          EXPECT_EQ(g.edge_a[k][a], w.edge_a[k][b]);
+          EXPECT_EQ(g.edge_b[k][a], w.edge_b[k][b]);
+          EXPECT_EQ(g.edge_c[k][a], w.edge_c[k][b]);
+          EXPECT_TRUE(same(g.z[k][a], w.z[k][b]));
+          EXPECT_TRUE(same(g.inv_w[k][a], w.inv_w[k][b]));
+          for (int v = 0; v < kKernelVaryings; ++v) {
+            EXPECT_TRUE(same(g.var[v][k][a], w.var[v][k][b]));
+          }
+        }
+        for (int k = 0; k < 4; ++k) EXPECT_EQ(g.bounds[k][a], w.bounds[k][b]);
+        for (int k = 0; k < 2; ++k) EXPECT_EQ(g.blocks[k][a], w.blocks[k][b]);
+        EXPECT_EQ(g.area[a], w.area[b]);
+        EXPECT_EQ((g.small >> a) & 1u, (w.small >> b) & 1u);
+        EXPECT_EQ((g.scalar_planes >> a) & 1u, (w.scalar_planes >> b) & 1u);
+        EXPECT_TRUE(same(g.x_ref[a], w.x_ref[b]) && same(g.y_ref[a], w.y_ref[b]));
+        if (::testing::Test::HasFailure()) return;
+        ++compared;
+        if (w.blocks[1][b] != 0) ++lower_blocks;
+      }
+    }
+  }
+  if (levels == 0) GTEST_SKIP() << "no level with gathering on this CPU (AVX-512)";
+  // (One level, AVX-512: 5941 lanes, 367 gathered groups, 40 ended by the scalar path, 32 lanes
+  // of specks reaching the lower blocks of their area.)
+  EXPECT_GT(compared, 3000 * levels);
+  EXPECT_GT(gathered_groups, 200 * levels);
+  EXPECT_GT(scalar_groups, 20 * levels);
+  EXPECT_GT(lower_blocks, 15 * levels);
+}
+
 // write_records against the field-by-field writers, for lanes of random bits (every field's
 // value range, negative and zero areas, both signs of the 32-bit edge coefficients), every number
 // of varyings it takes, both windings as front and both group widths: the same bytes in every

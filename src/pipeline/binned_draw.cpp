@@ -232,6 +232,38 @@ class BinnedDraw {
       // records hold no vertices and at most kMaxTransposedVaryings varyings.
       const bool transposed = !scanline_ && batch.num_varyings <= kMaxTransposedVaryings;
       alignas(32) std::byte scratch[kMaxTransposedBytes];
+      // A group's triangles as records, in lane order: the set-up ones (planes made), and those
+      // the kernel left to the scalar path (triangle t + l) through it, in their place.
+      auto emit = [&](const TriangleLanes& g, size_t t) {
+        const uint32_t ready = g.ready, two = ready & (ready - 1), three = two & (two - 1);
+        if (transposed && (g.scalar | g.scalar_planes) == 0 && (three & (three - 1)) != 0) {
+          add_group(chunk, g, int(width), scratch);
+          return;
+        }
+        for (uint32_t todo = g.ready | g.scalar; todo != 0; todo &= todo - 1) {
+          int l = __builtin_ctz(todo);
+          if ((g.scalar >> l) & 1u) {
+            vertices.triangle(geometry_, indices + 3 * (t + size_t(l)), keep, add);
+          } else {
+            add_set_up(chunk, g, l);
+          }
+        }
+      };
+      // The set-up triangles of consecutive groups gathered into full groups before their planes
+      // and records are made (triangle_kernels.hpp): on a dense closed mesh about 40 % of the
+      // lanes are culled or dropped, and the planes and the record transpose cost the same for a
+      // lane that is not ready. A group with a lane for the scalar path ends the gathering (what
+      // is gathered goes first), so the records keep submission order.
+      const bool gather = transposed && triangle_kernel_.append != nullptr;
+      TriangleLanes full{};  // (vertex 0 in the lanes not yet used: every lane's loads are valid)
+      int filled = 0;
+      auto flush = [&] {
+        if (filled == 0) return;
+        triangle_kernel_.finish(batch, full);
+        emit(full, 0);
+        full.ready = 0;
+        filled = 0;
+      };
       for (size_t t = begin; t < end; t += width) {
         // The varyings of the group after next, prefetched: the kernel reads them late in its
         // work, each vertex's from wherever its index points, and a miss there stalled the
@@ -247,21 +279,35 @@ class BinnedDraw {
             }
           }
         }
-        triangle_kernel_.fn(batch, t, int(std::min(width, end - t)), lanes);
-        const uint32_t ready = lanes.ready, two = ready & (ready - 1), three = two & (two - 1);
-        if (transposed && (lanes.scalar | lanes.scalar_planes) == 0 && (three & (three - 1)) != 0) {
-          add_group(chunk, lanes, int(width), scratch);
+        const int count = int(std::min(width, end - t));
+        if (!gather) {
+          triangle_kernel_.fn(batch, t, count, lanes);
+          emit(lanes, t);
           continue;
         }
-        for (uint32_t todo = lanes.ready | lanes.scalar; todo != 0; todo &= todo - 1) {
-          int l = __builtin_ctz(todo);
-          if ((lanes.scalar >> l) & 1u) {
-            vertices.triangle(geometry_, indices + 3 * (t + size_t(l)), keep, add);
-          } else {
-            add_set_up(chunk, lanes, l);
-          }
+        triangle_kernel_.select(batch, t, count, lanes);
+        if (lanes.scalar != 0) {
+          flush();
+          triangle_kernel_.finish(batch, lanes);
+          emit(lanes, t);
+          continue;
         }
+        const uint32_t ready = lanes.ready;
+        const int k = __builtin_popcount(ready), room = int(width) - filled;
+        if (k < room) {
+          triangle_kernel_.append(lanes, ready, full, filled);
+          filled += k;
+          continue;
+        }
+        uint32_t rest = ready;  // the lanes past the first `room`
+        for (int i = 0; i < room; ++i) rest &= rest - 1;
+        triangle_kernel_.append(lanes, ready & ~rest, full, filled);
+        filled = int(width);
+        flush();
+        triangle_kernel_.append(lanes, rest, full, 0);
+        filled = k - room;
       }
+      flush();
       return;
     }
     for (size_t t = begin; t < end; ++t) vertices.triangle(geometry_, indices + 3 * t, keep, add);
@@ -478,20 +524,28 @@ class BinnedDraw {
   }
 
   // The phase's tiles (cache_.tile_order) by place, into cache_.place_tiles, and the places'
-  // counters at 0. The cache keeps the capacity of both.
+  // counters at 0. Sized for every place the draw's threads may use and every tile, once: which
+  // place gets how many tiles depends on which thread set up which chunk, so it changes from
+  // frame to frame, and a later frame must not allocate (tests/allocation_test.cpp).
   void place_jobs(size_t workers) {
+    const size_t places = std::max<size_t>(workers, size_t(threads_));
+    const size_t all_tiles = size_t(tiles_x_) * size_t(tiles_y_);
     std::vector<std::vector<uint32_t>>& tiles = cache_.place_tiles;
-    if (tiles.size() < workers) tiles.resize(workers);
-    for (size_t p = 0; p < workers; ++p) tiles[p].clear();
-    if (cache_.num_counters < workers) {
-      cache_.counters = std::make_unique<PlaceCounters[]>(workers);
-      cache_.num_counters = workers;
+    if (tiles.size() < places) tiles.resize(places);
+    for (size_t p = 0; p < workers; ++p) {
+      tiles[p].clear();
+      if (tiles[p].capacity() < all_tiles) tiles[p].reserve(all_tiles);
+    }
+    if (cache_.num_counters < places) {
+      cache_.counters = std::make_unique<PlaceCounters[]>(places);
+      cache_.num_counters = places;
     }
     for (size_t p = 0; p < workers; ++p) {
       cache_.counters[p].chunk.store(0, std::memory_order_relaxed);
       cache_.counters[p].tile.store(0, std::memory_order_relaxed);
     }
     std::vector<size_t>& records = cache_.place_records;
+    if (records.capacity() < places) records.reserve(places);
     records.resize(workers);
     for (const auto& [busy, tile] : cache_.tile_order) {
       size_t owner = 0;

@@ -307,7 +307,45 @@ template <class T, class V>
 #endif
 }
 
-void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLanes& out) {
+// triangle_bounds inside the scissor from the clockwise corners (ceil_div(min - 128, 256) is
+// (min + 127) >> 8, floor_div(max - 128, 256) + 1 is ((max - 128) >> 8) + 1), and the corners'
+// extents.
+struct LaneBounds {
+  I x0, y0, x1, y1;
+  I width_fx8, height_fx8;  // max - min of the corners' x and y, in 1/256 pixel
+};
+[[gnu::always_inline]] inline LaneBounds lane_bounds(const I (&vx)[3], const I (&vy)[3],
+                                                     const PixelRect& scissor) {
+  const I xmin = min3(vx[0], vx[1], vx[2]), xmax = max3(vx[0], vx[1], vx[2]);
+  const I ymin = min3(vy[0], vy[1], vy[2]), ymax = max3(vy[0], vy[1], vy[2]);
+  LaneBounds r;
+  r.x0 = (xmin + (kSubpixelHalf - 1)) >> kSubpixelBits;
+  r.y0 = (ymin + (kSubpixelHalf - 1)) >> kSubpixelBits;
+  r.x1 = ((xmax - kSubpixelHalf) >> kSubpixelBits) + 1;
+  r.y1 = ((ymax - kSubpixelHalf) >> kSubpixelBits) + 1;
+  const I sx0 = I{} + scissor.x0, sy0 = I{} + scissor.y0;
+  const I sx1 = I{} + scissor.x1, sy1 = I{} + scissor.y1;
+  r.x0 = r.x0 > sx0 ? r.x0 : sx0;
+  r.y0 = r.y0 > sy0 ? r.y0 : sy0;
+  r.x1 = r.x1 < sx1 ? r.x1 : sx1;
+  r.y1 = r.y1 < sy1 ? r.y1 : sy1;
+  r.width_fx8 = xmax - xmin;
+  r.height_fx8 = ymax - ymin;
+  return r;
+}
+
+// Edge k's a, b and bias as make_edge(vertex k, vertex k + 1) makes them: a = -dy, b = dx, and
+// -1 unless the edge is top or left (is_top_left), else 0.
+[[gnu::always_inline]] inline void lane_edge(const I (&vx)[3], const I (&vy)[3], int k, I& a, I& b,
+                                             I& bias) {
+  const int j = (k + 1) % 3;
+  const I dx = vx[j] - vx[k], dy = vy[j] - vy[k];
+  a = -dy;
+  b = dx;
+  bias = ~((dy < 0) | ((dy == 0) & (dx > 0)));
+}
+
+void select_triangles(const TriangleBatch& b, size_t first, int count, TriangleLanes& out) {
   const uint32_t* p = b.indices + 3 * first;
   alignas(64) uint32_t tail[3 * kL];
   if (count < kL) {  // the last group of a chunk: its indices, then zeros (lanes not valid)
@@ -370,39 +408,13 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
   const I vx[3] = {x0, ccw ? x2 : x1, ccw ? x1 : x2};
   const I vy[3] = {y0, ccw ? y2 : y1, ccw ? y1 : y2};
   const I vi[3] = {i0, ccw ? i2 : i1, ccw ? i1 : i2};
-  const I xmin = min3(x0, x1, x2), xmax = max3(x0, x1, x2);
-  const I ymin = min3(y0, y1, y2), ymax = max3(y0, y1, y2);
-  I bx0 = (xmin + (kSubpixelHalf - 1)) >> kSubpixelBits;
-  I by0 = (ymin + (kSubpixelHalf - 1)) >> kSubpixelBits;
-  I bx1 = ((xmax - kSubpixelHalf) >> kSubpixelBits) + 1;
-  I by1 = ((ymax - kSubpixelHalf) >> kSubpixelBits) + 1;
-  const I sx0 = I{} + b.scissor.x0, sy0 = I{} + b.scissor.y0;
-  const I sx1 = I{} + b.scissor.x1, sy1 = I{} + b.scissor.y1;
-  bx0 = bx0 > sx0 ? bx0 : sx0;
-  by0 = by0 > sy0 ? by0 : sy0;
-  bx1 = bx1 < sx1 ? bx1 : sx1;
-  by1 = by1 < sy1 ? by1 : sy1;
+  const LaneBounds bounds = lane_bounds(vx, vy, b.scissor);
+  const I bx0 = bounds.x0, by0 = bounds.y0, bx1 = bounds.x1, by1 = bounds.y1;
   const I inside = (bx0 < bx1) & (by0 < by1);
   out.ready = lane_bits(kept & inside);
-  // BinnedDraw::add_triangle: the 32-bit coverage path's extents.
-  out.small = lane_bits((xmax - xmin <= int32_t(kSmallTriangleFx8)) &
-                        (ymax - ymin <= int32_t(kSmallTriangleFx8)));
-
-  // Edge functions as make_edge(vertex k, vertex k + 1) makes them: a = -dy, b = dx,
-  // c = dy xi - dx yi, one less unless the edge is top or left (is_top_left).
-  I edge_a[3], edge_b[3];
-  Q edge_c[3];
-  I bias[3];  // -1 unless the edge is top or left, else 0
-  for (int k = 0; k < 3; ++k) {
-    const int j = (k + 1) % 3;
-    const I dx = vx[j] - vx[k], dy = vy[j] - vy[k];
-    edge_a[k] = -dy;
-    edge_b[k] = dx;
-    bias[k] = ~((dy < 0) | ((dy == 0) & (dx > 0)));
-    const D c = SOFTRAST_TO_DOUBLE(dy) * SOFTRAST_TO_DOUBLE(vx[k]) -
-                SOFTRAST_TO_DOUBLE(dx) * SOFTRAST_TO_DOUBLE(vy[k]);
-    edge_c[k] = SOFTRAST_EXACT_INT64(c) + __builtin_convertvector(bias[k], Q);
-  }
+  // The edges' a, b and bias, for the speck test below (finish_lanes makes the edges' c).
+  I edge_a[3], edge_b[3], bias[3];
+  for (int k = 0; k < 3; ++k) lane_edge(vx, vy, k, edge_a[k], edge_b[k], bias[k]);
 
   // A triangle whose bounds are at most 4x4 pixels and whose edges pass no sample inside them
   // (a sliver or a speck between pixel centres: a sixth of spheres_1m's records) covers no pixel:
@@ -413,8 +425,8 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
   // in 1/256), so |a|, |b| <= 1536, and the 16 samples lie within 2304 of every vertex:
   // |E| <= 2 * 1536 * 2304 < 2^23.
   const I width = bx1 - bx0, height = by1 - by0;
-  const I speck = kept & inside & (width <= 4) & (height <= 4) & (xmax - xmin <= 6 * kSubpixelOne) &
-                  (ymax - ymin <= 6 * kSubpixelOne);
+  const I speck = kept & inside & (width <= 4) & (height <= 4) &
+                  (bounds.width_fx8 <= 6 * kSubpixelOne) & (bounds.height_fx8 <= 6 * kSubpixelOne);
   if (lane_bits(speck) != 0) {
     // Every value below is 0 in the other lanes (unused; no overflow there).
     const I sx = (bx0 * kSubpixelOne + kSubpixelHalf) & speck;
@@ -462,10 +474,6 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
     std::memset(out.blocks, 0, sizeof out.blocks);
   }
 
-  std::memcpy(out.bounds[0], &bx0, sizeof bx0);
-  std::memcpy(out.bounds[1], &by0, sizeof by0);
-  std::memcpy(out.bounds[2], &bx1, sizeof bx1);
-  std::memcpy(out.bounds[3], &by1, sizeof by1);
   for (int h = 0; h < 2; ++h) {  // SOFTRAST_EXACT_INT64 half by half
     store_half(out.area, h, QH(area[h] + (DH{} + 0x1.8p52)) - QH(DH{} + 0x1.8p52));
   }
@@ -473,12 +481,94 @@ void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLa
     std::memcpy(out.vertex[k], &vi[k], sizeof vi[k]);
     std::memcpy(out.x[k], &vx[k], sizeof vx[k]);
     std::memcpy(out.y[k], &vy[k], sizeof vy[k]);
-    std::memcpy(out.edge_a[k], &edge_a[k], sizeof edge_a[k]);
-    std::memcpy(out.edge_b[k], &edge_b[k], sizeof edge_b[k]);
-    std::memcpy(out.edge_c[k], &edge_c[k], sizeof edge_c[k]);
   }
-  if (out.ready != 0) setup_plane_lanes(b, out);
 }
+
+// The rest of the ready lanes' coverage, from their clockwise corners (out.x, out.y): the bounds
+// and the 32-bit flag as select_triangles found them, and the edge functions (c = dy xi - dx yi,
+// plus the bias).
+[[gnu::always_inline]] inline void finish_coverage(const TriangleBatch& b, TriangleLanes& out) {
+  I vx[3], vy[3];
+  for (int k = 0; k < 3; ++k) {
+    std::memcpy(&vx[k], out.x[k], sizeof vx[k]);
+    std::memcpy(&vy[k], out.y[k], sizeof vy[k]);
+  }
+  const LaneBounds bounds = lane_bounds(vx, vy, b.scissor);
+  std::memcpy(out.bounds[0], &bounds.x0, sizeof bounds.x0);
+  std::memcpy(out.bounds[1], &bounds.y0, sizeof bounds.y0);
+  std::memcpy(out.bounds[2], &bounds.x1, sizeof bounds.x1);
+  std::memcpy(out.bounds[3], &bounds.y1, sizeof bounds.y1);
+  // BinnedDraw::add_triangle: the 32-bit coverage path's extents.
+  out.small = lane_bits((bounds.width_fx8 <= int32_t(kSmallTriangleFx8)) &
+                        (bounds.height_fx8 <= int32_t(kSmallTriangleFx8)));
+  for (int k = 0; k < 3; ++k) {
+    I a, bb, bias;
+    lane_edge(vx, vy, k, a, bb, bias);
+    const D c = SOFTRAST_TO_DOUBLE(-a) * SOFTRAST_TO_DOUBLE(vx[k]) -
+                SOFTRAST_TO_DOUBLE(bb) * SOFTRAST_TO_DOUBLE(vy[k]);
+    const Q edge_c = SOFTRAST_EXACT_INT64(c) + __builtin_convertvector(bias, Q);
+    std::memcpy(out.edge_a[k], &a, sizeof a);
+    std::memcpy(out.edge_b[k], &bb, sizeof bb);
+    std::memcpy(out.edge_c[k], &edge_c, sizeof edge_c);
+  }
+}
+
+void finish_triangles(const TriangleBatch& b, TriangleLanes& out) {
+  if (out.ready == 0) return;
+  finish_coverage(b, out);
+  setup_plane_lanes(b, out);
+}
+
+void setup_triangles(const TriangleBatch& b, size_t first, int count, TriangleLanes& out) {
+  select_triangles(b, first, count, out);
+  finish_triangles(b, out);
+}
+
+#if SOFTRAST_TRIANGLE_LANES == 16
+// What select_triangles found for `from`'s lanes in `mask` (vertex, x, y, area, blocks), in lane
+// order, to `to`'s lanes at, at + 1, ... (at + their number <= kL). AVX-512 only: AVX2 has no
+// compress, and gathering with a lane-by-lane copy made spheres_1m 4 % slower there.
+void append_lanes(const TriangleLanes& from, uint32_t mask, TriangleLanes& to, int at) {
+  const int n = __builtin_popcount(mask);
+  if (n == 0) return;
+  // Lane at + i of the result takes the i-th chosen lane: the chosen lanes' numbers in order (one
+  // compress), moved up by `at` lanes (one permute); then each row put in that order by a
+  // permute and stored whole-row aligned, masked to lanes at to at + n - 1. (A compress is two
+  // operations on the one port that shuffles, a permute one; stored from lane `at` instead, each
+  // row was a store split across two cache lines, and the stores backed up: a third of the
+  // append's time.)
+  const __m512i lane = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const __m512i order = _mm512_permutexvar_epi32(
+      _mm512_and_si512(_mm512_sub_epi32(lane, _mm512_set1_epi32(at)), _mm512_set1_epi32(15)),
+      _mm512_maskz_compress_epi32(__mmask16(mask), lane));
+  const __mmask16 stored = __mmask16(((1u << n) - 1u) << at);
+  auto row = [&](const auto* src, auto* dst) {
+    _mm512_mask_store_epi32(dst, stored, _mm512_permutexvar_epi32(order, _mm512_load_si512(src)));
+  };
+  // 64-bit rows (two registers of 8 lanes): each half of the result from both of the source's.
+  const __m512i low8 = _mm512_cvtepu32_epi64(_mm512_castsi512_si256(order));
+  const __m512i high8 = _mm512_cvtepu32_epi64(_mm512_extracti64x4_epi64(order, 1));
+  const __mmask8 stored_low = __mmask8(stored), stored_high = __mmask8(stored >> 8);
+  auto row64 = [&](const int64_t* src, int64_t* dst) {
+    const __m512i a = _mm512_load_si512(src), c = _mm512_load_si512(src + 8);
+    if (stored_low != 0) {
+      _mm512_mask_store_epi64(dst, stored_low, _mm512_permutex2var_epi64(a, low8, c));
+    }
+    if (stored_high != 0) {
+      _mm512_mask_store_epi64(dst + 8, stored_high, _mm512_permutex2var_epi64(a, high8, c));
+    }
+  };
+  for (int k = 0; k < 3; ++k) {
+    row(from.vertex[k], to.vertex[k]);
+    row(from.x[k], to.x[k]);
+    row(from.y[k], to.y[k]);
+  }
+  for (int k = 0; k < 2; ++k) row(from.blocks[k], to.blocks[k]);
+  row64(from.area, to.area);
+  const uint32_t lanes = ((1u << n) - 1u) << at;
+  to.ready |= lanes;
+}
+#endif
 
 #undef SOFTRAST_TO_DOUBLE
 #undef SOFTRAST_EXACT_INT64
