@@ -532,10 +532,10 @@ class BinnedDraw {
     const size_t all_tiles = size_t(tiles_x_) * size_t(tiles_y_);
     std::vector<std::vector<uint32_t>>& tiles = cache_.place_tiles;
     if (tiles.size() < places) tiles.resize(places);
-    for (size_t p = 0; p < workers; ++p) {
-      tiles[p].clear();
+    for (size_t p = 0; p < places; ++p) {
       if (tiles[p].capacity() < all_tiles) tiles[p].reserve(all_tiles);
     }
+    for (size_t p = 0; p < workers; ++p) tiles[p].clear();
     if (cache_.num_counters < places) {
       cache_.counters = std::make_unique<PlaceCounters[]>(places);
       cache_.num_counters = places;

@@ -412,7 +412,7 @@ void select_triangles(const TriangleBatch& b, size_t first, int count, TriangleL
   const I bx0 = bounds.x0, by0 = bounds.y0, bx1 = bounds.x1, by1 = bounds.y1;
   const I inside = (bx0 < bx1) & (by0 < by1);
   out.ready = lane_bits(kept & inside);
-  // The edges' a, b and bias, for the speck test below (finish_lanes makes the edges' c).
+  // The edges' a, b and bias, for the speck test below (finish_triangles makes the edges' c).
   I edge_a[3], edge_b[3], bias[3];
   for (int k = 0; k < 3; ++k) lane_edge(vx, vy, k, edge_a[k], edge_b[k], bias[k]);
 
