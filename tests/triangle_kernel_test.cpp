@@ -324,9 +324,9 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
 
 // The kernel in the steps the binned draw gathers with (AVX-512): each group's select, its ready
 // lanes appended to a gathering group (at any offset, in pieces when they do not fit, into a
-// group that starts as garbage), then that group's finish; a group with a lane for the scalar
-// path ends the gathering. Every ready lane must equal its lane of the one-step kernel (fn),
-// field for field and bit for bit, planes included, in submission order.
+// group that starts as another group's selection), then that group's finish; a group with a lane
+// for the scalar path ends the gathering. Every ready lane must equal its lane of the one-step
+// kernel (fn), field for field and bit for bit, planes included, in submission order.
 TEST(TriangleKernel, GatheredGroupsEqualTheWholeGroups) {
   const int kVertices = 3000;
   std::vector<float> data = kernel_vertices(kVertices, 23);
@@ -372,12 +372,14 @@ TEST(TriangleKernel, GatheredGroupsEqualTheWholeGroups) {
       // The one-step kernel's ready lanes, in submission order, and the gathered ones.
       std::vector<std::pair<const detail::TriangleLanes*, int>> want, got;
       std::vector<std::unique_ptr<detail::TriangleLanes>> keep;
-      // A gathering group starts as garbage but for its vertex indices (finish reads the
-      // vertices of every lane), so that a field append does not copy cannot match by chance.
-      auto fresh = [] {
+      // A gathering group starts as another group's selection (other triangles' values, each in
+      // its field's range, as finish computes on every lane), so that a field append does not
+      // copy cannot match by chance.
+      int decoys = 0;
+      auto fresh = [&] {
         auto g = std::make_unique<detail::TriangleLanes>();
-        std::memset(static_cast<void*>(g.get()), 0xa5, sizeof *g);
-        std::memset(g->vertex, 0, sizeof g->vertex);
+        const size_t groups = size_t(kTriangles) / size_t(width);
+        kernel.select(batch, (size_t(decoys++) * 7 % groups) * size_t(width), width, *g);
         g->ready = 0;
         return g;
       };
