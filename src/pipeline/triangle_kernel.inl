@@ -565,8 +565,7 @@ void append_lanes(const TriangleLanes& from, uint32_t mask, TriangleLanes& to, i
   }
   for (int k = 0; k < 2; ++k) row(from.blocks[k], to.blocks[k]);
   row64(from.area, to.area);
-  const uint32_t lanes = ((1u << n) - 1u) << at;
-  to.ready |= lanes;
+  to.ready |= stored;
 }
 #endif
 

@@ -37,8 +37,7 @@ TriangleKernel triangle_kernel(SimdLevel level) {
       return {&avx512::setup_triangles, 16, &avx512::select_triangles, &avx512::finish_triangles,
               &avx512::append_lanes};
     case SimdLevel::kAvx2:
-      return {&avx2::setup_triangles, 8, &avx2::select_triangles, &avx2::finish_triangles,
-              nullptr};
+      return {&avx2::setup_triangles, 8, &avx2::select_triangles, &avx2::finish_triangles, nullptr};
     default:
       return {};
   }
