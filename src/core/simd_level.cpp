@@ -1,7 +1,9 @@
 // core/simd_level.cpp: CPU feature detection, the process-wide SIMD level cap, the choice
 // between the gather instruction and per-lane loads, and that between masked stores and blends.
+// Also whether PREFETCHW is there (core/prefetch.hpp).
 #include "softrast/simd_level.hpp"
 
+#include <cpuid.h>
 #include <immintrin.h>
 
 #include <algorithm>
@@ -13,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/prefetch.hpp"
 #include "core/store_mode.hpp"
 #include "softrast/simd.hpp"
 
@@ -204,6 +207,13 @@ bool avx2_masked_stores() {
 }
 void set_avx2_masked_stores(bool masked) {
   masked_stores_flag().store(masked, std::memory_order_relaxed);
+}
+bool prefetch_for_write_supported() {
+  static const bool supported = [] {
+    unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+    return __get_cpuid(0x80000001u, &eax, &ebx, &ecx, &edx) != 0 && (ecx & bit_PRFCHW) != 0;
+  }();
+  return supported;
 }
 }  // namespace detail
 

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/prefetch.hpp"
 #include "raster/setup.hpp"
 #include "softrast/detail/interpolants.hpp"
 
@@ -83,6 +84,12 @@ class RecordArena {
     return uint32_t(offset);
   }
   TriRecord* at(uint32_t offset) { return reinterpret_cast<TriRecord*>(data_.data() + offset); }
+  // Asks for the lines of [offset, offset + bytes), clipped to the arena's capacity, for writing
+  // (prefetch_line_for_write; only where prefetch_for_write_supported()).
+  void prefetch_for_write(size_t offset, size_t bytes) const {
+    const size_t end = std::min(offset + bytes, data_.size());
+    for (size_t at = offset; at < end; at += 64) prefetch_line_for_write(data_.data() + at);
+  }
   const std::byte* data() const { return data_.data(); }
   size_t used() const { return used_; }
 
