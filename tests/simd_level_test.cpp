@@ -93,6 +93,39 @@ INSTANTIATE_TEST_SUITE_P(AllShaders, SimdLevelGolden,
                            return std::string(shader_kind_name(info.param));
                          });
 
+// The built-in Gouraud shader's blocks of several small triangles: at AVX-512 they are shaded in
+// one call, each lane with its own triangle's planes (shade_mixed, kCheapToShade), below it one
+// call per triangle. Either way every pixel gets the bits of the reference path (one triangle at
+// a time, no tiles), at every level, for one-sided and two-sided lighting (culling off: both
+// facings, never mixed in one call) and for one and two threads. The demo scene at 96 x 72 is
+// triangles of a few pixels, most blocks shared by several of them.
+TEST(SimdLevel, GouraudOfSmallTrianglesEqualsTheReferencePathAtEveryLevel) {
+  SimdLevelGuard guard;
+  static const DemoScene scene = make_demo_scene();
+  for (SimdLevel level : test::levels_of_this_cpu()) {
+    set_simd_level(level);
+    for (bool two_sided : {false, true}) {
+      RenderOptions options;
+      options.shader = ShaderKind::kGouraud;
+      options.two_sided_lighting = two_sided;
+      options.state.cull = two_sided ? CullMode::kNone : CullMode::kBack;
+      std::vector<Image> images;
+      for (int threads : {0, 1, 2}) {  // 0: the reference path
+        options.state.threads = threads;
+        options.state.reference_path = threads == 0;
+        Framebuffer fb(96, 72);
+        render_mesh(fb, scene.mesh, scene.camera, options);
+        images.push_back(fb.to_image());
+      }
+      for (size_t i = 1; i < images.size(); ++i) {
+        EXPECT_TRUE(images[i].rgba == images[0].rgba)
+            << simd_level_name(level) << (two_sided ? " two-sided" : " one-sided") << ", " << i
+            << " thread(s)";
+      }
+    }
+  }
+}
+
 // The wide sampler against Texture::sample, lane by lane, at one level (N lanes per vector).
 // Derivatives for the trilinear case: each lane's uv changes by (lane-dependent) amounts that
 // span magnification to far past the last level.

@@ -27,9 +27,12 @@
 // and a 4x4 block whose pixels several triangles cover is then shaded in one call, each pixel
 // with its own triangle's varyings (a 2x2 quad may mix triangles, so ddx and ddy would be
 // meaningless there: they stop the program with a message if called after all). A shader whose
-// fragment work is only a few operations (the built-in Gouraud copies its varyings) gains nothing
+// fragment work is only a few operations (the built-in Gouraud copies its varyings) gains little
 // from that, since picking each pixel's triangle costs about as much; it may say so with
 //   static constexpr bool kCheapToShade = true;
+// and is then shaded that way only at AVX-512 (16 lanes to fill, and a permute per coefficient)
+// and only in tiles shaded as their triangles come (the held blocks of a dense mesh), one
+// triangle per call elsewhere.
 // A scalar shader is taken to discard (it returns a bool) and is always shaded immediately.
 //
 // The vertex shader pulls its own inputs by index (from whatever arrays the shader holds), so
@@ -146,8 +149,10 @@ void draw(Framebuffer& framebuffer, const RenderState& state, const S& shader,
   if constexpr (detail::WideShader<S>) {
     program.shade_block = detail::wide_shade_block<S>(simd_level());
     program.deferrable = !detail::WritesDepth<S> && !detail::DeclaresDiscards<S>;
-    if (program.deferrable && !detail::reads_derivatives(shader) && !detail::CheapToShade<S>) {
+    if (program.deferrable && !detail::reads_derivatives(shader) &&
+        (!detail::CheapToShade<S> || simd_level() >= SimdLevel::kAvx512)) {
       program.shade_mixed = detail::wide_shade_mixed<S>(simd_level());
+      program.mixed_winners = !detail::CheapToShade<S>;
     }
   } else {
     program.shade_block = &detail::shade_block<S>;

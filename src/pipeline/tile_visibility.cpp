@@ -73,7 +73,7 @@ void shade_winners(const TileVisibility& vis, const Interpolants* const* interps
       uint32_t left = ~lanes_equal(ids, TileVisibility::kNoWinner) & 0xffffu;
       int x = vis.region.x0 + (b % kPerRow) * kBlockSize;
       int y = vis.region.y0 + (b / kPerRow) * kBlockSize;
-      if (program.shade_mixed == nullptr) {
+      if (program.shade_mixed == nullptr || !program.mixed_winners) {
         // One call per distinct winner of the block, with exactly the pixels it won.
         while (left != 0) {
           int32_t winner = ids[__builtin_ctz(left)];

@@ -149,8 +149,11 @@ template <bool kTwoSided>
 struct GouraudShader {
   static constexpr int kVaryings = kTwoSided ? 6 : 3;
   // Its fragment stage copies three varyings: shading several small triangles per call (lanes
-  // picking their triangle's planes) measured as slow or slower (spheres_1m, AVX2 61 -> 65 ms).
+  // picking their triangle's planes) costs about what it saves. Below AVX-512 it is slower
+  // (spheres_1m gouraud, one thread, AVX2: 50.7 -> 55.5 ms), at AVX-512 a little faster (43.3 ->
+  // 42.7), which is where shader.hpp takes it for a kCheapToShade shader.
   static constexpr bool kCheapToShade = true;
+  bool reads_derivatives() const { return false; }
   MeshInputs in;
   glm::vec3 albedo;
   Lighting lighting;

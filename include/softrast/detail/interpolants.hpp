@@ -94,6 +94,9 @@ struct FragmentProgram {
   bool deferrable = false;
   bool writes_depth = false;           // the shader sets the depth (late depth test)
   ShadeMixedFn shade_mixed = nullptr;  // deferrable shaders that read no derivatives in this draw
+  // Whether deferred tiles' winners take shade_mixed too (else only immediate tiles' held blocks:
+  // kCheapToShade shaders, whose deferred blocks are mostly one triangle's).
+  bool mixed_winners = true;
 };
 
 // The vertex stage's output: per vertex a clip-space position (x, y, z, w) followed by
