@@ -138,7 +138,9 @@ TEST(Threading, ParallelSlotIsAStablePlacePerThread) {
     });
   }
   EXPECT_EQ(place_of[std::this_thread::get_id()], 0);
-  if (threads > 1) EXPECT_GT(place_of.size(), 1u) << "the pool's workers never ran";
+  if (threads > 1) {
+    EXPECT_GT(place_of.size(), 1u) << "the pool's workers never ran";
+  }
 }
 
 }  // namespace
