@@ -97,8 +97,8 @@ INSTANTIATE_TEST_SUITE_P(AllShaders, SimdLevelGolden,
 // one call, each lane with its own triangle's planes (shade_mixed, kCheapToShade), below it one
 // call per triangle. Either way every pixel gets the bits of the reference path (one triangle at
 // a time, no tiles), at every level, for one-sided and two-sided lighting (culling off: both
-// facings, never mixed in one call) and for one and two threads. The demo scene at 96 x 72 is
-// triangles of a few pixels, most blocks shared by several of them.
+// facings, never mixed in one call) and for one and two threads. At 96 x 72 the demo scene's
+// sphere and torus are triangles of a few pixels, whose blocks several of them share.
 TEST(SimdLevel, GouraudOfSmallTrianglesEqualsTheReferencePathAtEveryLevel) {
   SimdLevelGuard guard;
   static const DemoScene scene = make_demo_scene();
