@@ -86,6 +86,13 @@ SOFTRAST_AVX512 void lanes_of(uint32_t bits, I16& r);
 // r[i] = bit i of `bits` ? b : a, for 16 doubles.
 using D16 = double __attribute__((vector_size(128)));
 SOFTRAST_AVX512 void pick(uint32_t bits, const double& a, const double& b, D16& r);
+// 16 doubles as two registers of 8 (lanes 0 to 7, 8 to 15): a loop that carries D16 values is
+// split into scalars by GCC 12.
+using D8 = double __attribute__((vector_size(64)));
+// half[i] = b where bit i of `bits` is set, for lanes 0 to 7 of a D16 (`high`: 8 to 15); else
+// unchanged.
+SOFTRAST_AVX512 void merge(uint32_t bits, const double& b, D8& low, D8& high);
+SOFTRAST_AVX512 void join(const D8& low, const D8& high, D16& r);
 // AVX2's broadcasts, one VBROADCASTSS or VPBROADCASTD (the shuffle of lane 0 below is a move into
 // a zeroed register, a move to clear the upper lanes again and then the broadcast).
 using F8 = float __attribute__((vector_size(32)));
@@ -457,6 +464,14 @@ SOFTRAST_AVX512 void pick(uint32_t bits, const double& a, const double& b, D16& 
   const D8 second(_mm512_mask_blend_pd(__mmask8(bits >> 8), low, _mm512_set1_pd(b)));
   r = __builtin_shufflevector(first, second, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
 }
+SOFTRAST_AVX512 void merge(uint32_t bits, const double& b, D8& low, D8& high) {
+  const __m512d value = _mm512_set1_pd(b);
+  low = D8(_mm512_mask_blend_pd(__mmask8(bits), __m512d(low), value));
+  high = D8(_mm512_mask_blend_pd(__mmask8(bits >> 8), __m512d(high), value));
+}
+SOFTRAST_AVX512 void join(const D8& low, const D8& high, D16& r) {
+  r = __builtin_shufflevector(low, high, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+}
 SOFTRAST_AVX512 void store_lanes(uint32_t bits, const F16& v, float* to) {
   _mm512_mask_storeu_ps(to, __mmask16(bits), __m512(v));
 }
@@ -750,23 +765,6 @@ inline void lookup16(const float* table, const Native<4>::I& index, Native<4>::F
   // -Wmaybe-uninitialized reports (bug 105593).
   r = Native<16>::F(
       _mm512_maskz_permutexvar_ps(__mmask16(0xffff), __m512i(index), _mm512_loadu_ps(table)));
-}
-
-// r[i] = table[index[i]] for a table of 16 doubles, indices in [0, 16): at AVX-512 (the only
-// level with this one), a two-source permute per register of doubles.
-[[gnu::target("avx512f")]] inline void lookup16(const double* table, const Native<16>::I& index,
-                                                Native<16>::D& r) {
-  using I8 = Native<8>::I;
-  using D8 = Native<8>::D;
-  const __m512d low = _mm512_loadu_pd(table), high = _mm512_loadu_pd(table + 8);
-  const I8 first = __builtin_shufflevector(index, index, 0, 1, 2, 3, 4, 5, 6, 7);
-  const I8 second = __builtin_shufflevector(index, index, 8, 9, 10, 11, 12, 13, 14, 15);
-  // (The zero-masked widening: GCC 12's unmasked one draws bug 105593's warning.)
-  const D8 a =
-      D8(_mm512_permutex2var_pd(low, _mm512_maskz_cvtepu32_epi64(0xff, __m256i(first)), high));
-  const D8 b =
-      D8(_mm512_permutex2var_pd(low, _mm512_maskz_cvtepu32_epi64(0xff, __m256i(second)), high));
-  r = __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
 }
 
 // Each lane as two int16 halves: (a * b + 2^14) >> 15 half by half, the product rounded to 15

@@ -430,7 +430,7 @@ SOFTRAST_SIMD_INLINE void shade_block_wide(const S& shader, const ShadeTarget& t
 // Where shade_mixed_wide's lanes find their triangles' plane coefficients: x_ref(), y_ref(),
 // inv_w(j) (a0, dadx, dady for j = 0, 1, 2) and var(i, j), each a vector whose lane l holds the
 // coefficient of the triangle that covers pixel l (triangle 0's where none does: finite, never
-// written). Two sources give the same values (copies, no arithmetic).
+// written). Three sources give the same values (copies, no arithmetic).
 
 // The depth of each covered pixel of a MixedBlock from its own triangle's plane, clamped to
 // [0, 1] as shade_block_wide computes it; `z` (the stored depth) elsewhere. One plane at a time.
@@ -445,26 +445,22 @@ SOFTRAST_SIMD_INLINE void mixed_depth_by_triangle(const MixedBlock& block, const
   }
 }
 
-// Any number of triangles: the coefficients as a table in memory (entry k of a row: triangle
-// k's), one permute per row.
+// Any number of triangles, below AVX-512: the coefficients as a table in memory (entry k of a
+// row: triangle k's), one permute per row. (MixedMerged, AVX-512's, made spheres_1m phong 7 %
+// slower at AVX2, whose selects are twice as many, 8-lane, instructions.)
 template <class S, int N>
 struct MixedTable {
+  static_assert(N < 16);
   using F = simd::Float<N>;
   using I = simd::Int<N>;
   static constexpr int kN = S::kVaryings > 0 ? S::kVaryings : 1;
   enum { kXRef, kYRef, kInvW, kVar = kInvW + 3, kRows = kVar + 3 * kN };
   alignas(64) float table[kRows][16];
-  alignas(64) double depth_table[3][16];  // the depth planes' a0, dadx, dady (AVX-512)
   I lane_winner;
 
   SOFTRAST_SIMD_INLINE explicit MixedTable(const MixedBlock& block) : lane_winner(0) {
     for (int k = 0; k < block.count; ++k) {
       const Interpolants& in = *block.winner[k];
-      if constexpr (N == 16) {
-        depth_table[0][k] = in.z.a0;
-        depth_table[1][k] = in.z.dadx;
-        depth_table[2][k] = in.z.dady;
-      }
       table[kXRef][k] = in.x_ref;
       table[kYRef][k] = in.y_ref;
       table[kInvW][k] = in.inv_w.a0;
@@ -483,24 +479,10 @@ struct MixedTable {
   SOFTRAST_SIMD_INLINE F y_ref() const { return row(kYRef); }
   SOFTRAST_SIMD_INLINE F inv_w(int j) const { return row(kInvW + j); }
   SOFTRAST_SIMD_INLINE F var(int i, int j) const { return row(kVar + 3 * i + j); }
-  // mixed_depth_by_triangle's depths of the covered pixels (dx, dy: the pixels' offsets from
-  // their own triangle's reference point). At AVX-512, each lane's plane by a permute and one
-  // evaluation, eval_plane's operations on per-lane coefficients (the same bits; uncovered lanes
-  // get triangle 0's depth, never used); elsewhere one plane at a time.
-  SOFTRAST_SIMD_INLINE void depth(const MixedBlock& block, const F& px, const F& py, const F& dx,
-                                  const F& dy, F& z) const {
-    if constexpr (N == 16) {
-      using D = typename simd::Native<N>::D;
-      D a0, dadx, dady;
-      simd::isa::lookup16(depth_table[0], lane_winner.p[0], a0);
-      simd::isa::lookup16(depth_table[1], lane_winner.p[0], dadx);
-      simd::isa::lookup16(depth_table[2], lane_winner.p[0], dady);
-      const D x = __builtin_convertvector(dx.p[0], D), y = __builtin_convertvector(dy.p[0], D);
-      z.p[0] = __builtin_convertvector((a0 + dadx * x) + dady * y, typename simd::Native<N>::F);
-      z = simd::clamp(z, F(0.0f), F(1.0f));
-    } else {
-      mixed_depth_by_triangle<N>(block, px, py, z);
-    }
+  // mixed_depth_by_triangle's depths of the covered pixels, one plane at a time.
+  SOFTRAST_SIMD_INLINE void depth(const MixedBlock& block, const F& px, const F& py, const F&,
+                                  const F&, F& z) const {
+    mixed_depth_by_triangle<N>(block, px, py, z);
   }
 };
 
@@ -537,7 +519,7 @@ struct MixedPair {
   }
   // At AVX-512 each lane's depth plane is picked (the two planes' coefficients blended by the
   // second triangle's lanes) and evaluated once, eval_plane's operations on per-lane
-  // coefficients and the lane's own offsets (MixedTable's depth, the same bits); elsewhere one
+  // coefficients and the lane's own offsets (MixedMerged's depth, the same bits); elsewhere one
   // plane at a time. Evaluated for both triangles, the depth was about 60 of a block's 480
   // instructions.
   SOFTRAST_SIMD_INLINE void depth(const MixedBlock& block, const F& px, const F& py, const F& dx,
@@ -555,6 +537,68 @@ struct MixedPair {
     } else {
       mixed_depth_by_triangle<N>(block, px, py, z);
     }
+  }
+};
+
+// Any number of triangles at AVX-512, built in registers: every coefficient row starts as
+// triangle 0's value, and each further triangle's value is broadcast into its own lanes (one
+// masked broadcast per row and triangle). MixedTable's float stores and whole-row loads missed
+// store forwarding: its first row's permute took a sixth of spheres_1m gouraud's mixed-block
+// samples, where most blocks hold three to eight triangles (spheres_1m phong, one thread: 54.3
+// -> 52.1 ms).
+template <class S, int N>
+struct MixedMerged {
+  static_assert(N == 16);
+  using F = simd::Float<N>;
+  using I = simd::Int<N>;
+  using D = typename simd::Native<N>::D;
+  static constexpr int kN = S::kVaryings > 0 ? S::kVaryings : 1;
+  F ref[2];    // x_ref, y_ref
+  F w[3];      // inv_w's a0, dadx, dady
+  F v[kN][3];  // var[i]'s a0, dadx, dady
+  // The depth planes' a0, dadx, dady, lanes 0 to 7 and 8 to 15.
+  simd::isa::D8 z_low[3], z_high[3];
+
+  SOFTRAST_SIMD_INLINE explicit MixedMerged(const MixedBlock& block) {
+    using P = MixedPair<S, N>;
+    const Interpolants& first = *block.winner[0];
+    ref[0] = F(first.x_ref);
+    ref[1] = F(first.y_ref);
+    for (int j = 0; j < 3; ++j) w[j] = F(P::coefficient(first.inv_w, j));
+    for (int i = 0; i < S::kVaryings; ++i) {
+      for (int j = 0; j < 3; ++j) v[i][j] = F(P::coefficient(first.var[i], j));
+    }
+    const double* planes[3] = {&first.z.a0, &first.z.dadx, &first.z.dady};
+    for (int j = 0; j < 3; ++j) z_low[j] = z_high[j] = simd::isa::D8{} + *planes[j];
+    for (int k = 1; k < block.count; ++k) {
+      const Interpolants& t = *block.winner[k];
+      const I lanes = simd::lanes_of<N>(block.mask[k]);
+      ref[0] = simd::select(lanes, F(t.x_ref), ref[0]);
+      ref[1] = simd::select(lanes, F(t.y_ref), ref[1]);
+      for (int j = 0; j < 3; ++j) w[j] = simd::select(lanes, F(P::coefficient(t.inv_w, j)), w[j]);
+      for (int i = 0; i < S::kVaryings; ++i) {
+        for (int j = 0; j < 3; ++j) {
+          v[i][j] = simd::select(lanes, F(P::coefficient(t.var[i], j)), v[i][j]);
+        }
+      }
+      simd::isa::merge(block.mask[k], t.z.a0, z_low[0], z_high[0]);
+      simd::isa::merge(block.mask[k], t.z.dadx, z_low[1], z_high[1]);
+      simd::isa::merge(block.mask[k], t.z.dady, z_low[2], z_high[2]);
+    }
+  }
+  SOFTRAST_SIMD_INLINE F x_ref() const { return ref[0]; }
+  SOFTRAST_SIMD_INLINE F y_ref() const { return ref[1]; }
+  SOFTRAST_SIMD_INLINE F inv_w(int j) const { return w[j]; }
+  SOFTRAST_SIMD_INLINE F var(int i, int j) const { return v[i][j]; }
+  // Each lane's depth plane evaluated once, as MixedPair's (the same bits; lanes no triangle
+  // covers get the first's, never used).
+  SOFTRAST_SIMD_INLINE void depth(const MixedBlock&, const F&, const F&, const F& dx, const F& dy,
+                                  F& depth) const {
+    D z[3];
+    for (int j = 0; j < 3; ++j) simd::isa::join(z_low[j], z_high[j], z[j]);
+    const D x = __builtin_convertvector(dx.p[0], D), y = __builtin_convertvector(dy.p[0], D);
+    depth.p[0] = __builtin_convertvector((z[0] + z[1] * x) + z[2] * y, typename simd::Native<N>::F);
+    depth = simd::clamp(depth, F(0.0f), F(1.0f));
   }
 };
 
@@ -624,9 +668,11 @@ SOFTRAST_SIMD_INLINE void shade_mixed_wide(const S& shader, const ShadeTarget& t
                                            const MixedBlock& block, int x, int y) {
   if (block.count == 2) {
     shade_mixed_with<S, N>(shader, target, block, x, y, MixedPair<S, N>(block));
-    return;
+  } else if constexpr (N == 16) {
+    shade_mixed_with<S, N>(shader, target, block, x, y, MixedMerged<S, N>(block));
+  } else {
+    shade_mixed_with<S, N>(shader, target, block, x, y, MixedTable<S, N>(block));
   }
-  shade_mixed_with<S, N>(shader, target, block, x, y, MixedTable<S, N>(block));
 }
 
 template <class S, int N>
