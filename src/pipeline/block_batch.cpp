@@ -12,7 +12,41 @@ void BlockBatch::add(const Interpolants& in, int x, int y, uint32_t mask) {
   add_to_slot(in, x, y, mask, index);
 }
 
+inline void BlockBatch::start(Slot& slot, const Interpolants& in, int x, int y, uint32_t mask,
+                              int index) {
+  slot.x = x;
+  slot.y = y;
+  slot.covered = mask;
+  slot.block.front_facing = in.front_facing;
+  slot.block.winner[0] = &in;
+  slot.block.mask[0] = mask;
+  slot.block.count = 1;
+  held_[index >> 6] |= uint64_t(1) << (index & 63);
+}
+
+// The two usual cases need no call, so they save no registers: a block the slot already holds
+// gains pixels that leave it incomplete, or an empty slot takes a block. The rest (a call to the
+// fragment stage) goes on in add_with_shading.
 void BlockBatch::add_to_slot(const Interpolants& in, int x, int y, uint32_t mask, int index) {
+  Slot& slot = slots_[index];
+  MixedBlock& held = slot.block;
+  if (!holds(index)) {
+    if (mask != 0xffffu) {
+      start(slot, in, x, y, mask, index);
+      return;
+    }
+  } else if (slot.x == x && slot.y == y && (slot.covered & mask) == 0 &&
+             held.front_facing == in.front_facing && (slot.covered | mask) != 0xffffu) {
+    // (A whole block never joins: the slot holds pixels.)
+    held.winner[held.count] = &in;
+    held.mask[held.count++] = mask;  // at most 15 here: the masks are disjoint and not empty
+    slot.covered |= mask;
+    return;
+  }
+  add_with_shading(in, x, y, mask, index);
+}
+
+void BlockBatch::add_with_shading(const Interpolants& in, int x, int y, uint32_t mask, int index) {
   Slot& slot = slots_[index];
   MixedBlock& held = slot.block;
   bool same_block = holds(index) && slot.x == x && slot.y == y;
@@ -22,21 +56,14 @@ void BlockBatch::add_to_slot(const Interpolants& in, int x, int y, uint32_t mask
     return;
   }
   if (same_block && (slot.covered & mask) == 0 && held.front_facing == in.front_facing) {
-    held.winner[held.count] = &in;
-    held.mask[held.count++] = mask;  // at most 16: the masks are disjoint and not empty
+    held.winner[held.count] = &in;  // it completes the block: nothing more can join
+    held.mask[held.count++] = mask;
     slot.covered |= mask;
-    if (slot.covered == 0xffffu) shade(index);  // complete: nothing more can join
+    shade(index);
     return;
   }
   if (holds(index)) shade(index);
-  slot.x = x;
-  slot.y = y;
-  slot.covered = mask;
-  held.front_facing = in.front_facing;
-  held.winner[0] = &in;
-  held.mask[0] = mask;
-  held.count = 1;
-  held_[index >> 6] |= uint64_t(1) << (index & 63);
+  start(slot, in, x, y, mask, index);
 }
 
 void BlockBatch::flush() {

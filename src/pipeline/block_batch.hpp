@@ -60,6 +60,10 @@ class BlockBatch {
   // six registers these cases save and restore (24 instructions for a whole block, were 46).
   [[gnu::noinline]] void add_to_slot(const Interpolants& in, int x, int y, uint32_t mask,
                                      int index);
+  [[gnu::noinline]] void add_with_shading(const Interpolants& in, int x, int y, uint32_t mask,
+                                          int index);
+  // The slot (empty) takes the pixels `mask` of the block at (x, y).
+  void start(Slot& slot, const Interpolants& in, int x, int y, uint32_t mask, int index);
   void shade(int slot);
 
   const FragmentProgram* program_ = nullptr;
