@@ -126,6 +126,67 @@ TEST(SimdLevel, GouraudOfSmallTrianglesEqualsTheReferencePathAtEveryLevel) {
   }
 }
 
+// The built-in Gouraud shader interpolates the light's intensity alone where the albedo is the
+// material's (one varying a face), and the lit colour where each vertex has its own albedo
+// (three): the same colours up to the rounding of one product. Drawn both ways over the demo
+// scene at every level, with one thread and two: one-sided, and two-sided with each winding as
+// the front (culling off; the scene's closed meshes show the faces the other winding makes
+// back faces): the same depth everywhere, no channel more than 1 apart, and the scene lit.
+TEST(SimdLevel, GouraudByIntensityGivesTheLitColourWithinOne) {
+  SimdLevelGuard guard;
+  static const DemoScene scene = make_demo_scene();
+  constexpr int kWidth = 160, kHeight = 120;
+  detail::Lighting lighting;
+  lighting.light = glm::normalize(glm::vec3(0.3f, 0.5f, 0.8f));
+  const glm::vec3 albedo(0.8f, 0.55f, 0.3f);
+  const detail::MeshInputs in{&scene.mesh,
+                              scene.camera.view_projection(float(kWidth) / float(kHeight))};
+  const auto vertices = uint32_t(scene.mesh.positions.size());
+  struct Drawn {
+    Image image;
+    std::vector<float> depth;
+  };
+  auto drawn = [&](const auto& shader, int threads, FrontFace front) {
+    RenderState state;
+    state.cull = CullMode::kNone;
+    state.front_face = front;
+    state.threads = threads;
+    Framebuffer fb(kWidth, kHeight);
+    fb.clear(glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    draw(fb, state, shader, scene.mesh.indices, vertices);
+    return Drawn{fb.to_image(), fb.depth_values()};
+  };
+  auto expect_within_one = [&](const Drawn& a, const Drawn& b, const std::string& where) {
+    EXPECT_TRUE(a.depth == b.depth) << where;
+    int apart = 0, lit = 0;
+    for (size_t i = 0; i < a.image.rgba.size(); ++i) {
+      apart += std::abs(int(a.image.rgba[i]) - int(b.image.rgba[i])) > 1;
+      lit += i % 4 != 3 && a.image.rgba[i] > 0;
+    }
+    EXPECT_EQ(apart, 0) << where;
+    EXPECT_GT(lit, kWidth * kHeight / 4) << where;  // the scene is drawn, and lit
+  };
+  for (SimdLevel level : test::levels_of_this_cpu()) {
+    set_simd_level(level);
+    for (int threads : {1, 2}) {
+      const std::string at =
+          std::string(simd_level_name(level)) + ", " + std::to_string(threads) + " thread(s)";
+      const FrontFace ccw = FrontFace::kCounterClockwise;
+      expect_within_one(
+          drawn(detail::GouraudShader<false>{in, albedo, lighting, 1.0f, {}}, threads, ccw),
+          drawn(detail::GouraudShader<false, true>{in, albedo, lighting, 1.0f, {}}, threads, ccw),
+          at + ", one-sided");
+      for (FrontFace front : {ccw, FrontFace::kClockwise}) {
+        expect_within_one(
+            drawn(detail::GouraudShader<true>{in, albedo, lighting, 1.0f, {}}, threads, front),
+            drawn(detail::GouraudShader<true, true>{in, albedo, lighting, 1.0f, {}}, threads,
+                  front),
+            at + ", two-sided" + (front == ccw ? "" : ", clockwise front"));
+      }
+    }
+  }
+}
+
 // The wide sampler against Texture::sample, lane by lane, at one level (N lanes per vector).
 // Derivatives for the trilinear case: each lane's uv changes by (lane-dependent) amounts that
 // span magnification to far past the last level.

@@ -138,6 +138,12 @@ TEST(WideVertexShader, BuiltInShadersMatchTheirScalarVertexBitForBit) {
   expect_same_vertices(
       detail::GouraudShader<true>{in, glm::vec3(0.2f, 0.7f, 0.4f), lighting, 1.0f, {}},
       "gouraud two-sided", kCount);
+  expect_same_vertices(
+      detail::GouraudShader<false, true>{in, glm::vec3(0.9f, 0.6f, 0.3f), lighting, 1.0f, {}},
+      "gouraud, lit colour", kCount);
+  expect_same_vertices(
+      detail::GouraudShader<true, true>{in, glm::vec3(0.2f, 0.7f, 0.4f), lighting, 1.0f, {}},
+      "gouraud two-sided, lit colour", kCount);
   expect_same_vertices(detail::TextureShader(in), "texture", kCount);
   expect_same_vertices(detail::NormalsShader{in}, "normals", kCount);
   const detail::SurfaceMaps maps;
@@ -159,9 +165,9 @@ TEST(WideVertexShader, BuiltInShadersMatchTheirScalarVertexBitForBit) {
 TEST(WideVertexShader, VertexColoursTakeTheScalarVertexShader) {
   const Mesh mesh = test_mesh(20, 4);
   const detail::MeshInputs in = test_inputs(mesh);
-  detail::GouraudShader<false> plain{in, glm::vec3(0.5f), {}, 1.0f, {}};
+  detail::GouraudShader<false, true> plain{in, glm::vec3(0.5f), {}, 1.0f, {}};
   EXPECT_TRUE(detail::uses_wide_vertices(plain));
-  detail::GouraudShader<false> coloured = plain;
+  detail::GouraudShader<false, true> coloured = plain;
   coloured.colors.use = true;
   EXPECT_FALSE(detail::uses_wide_vertices(coloured));
   const detail::SurfaceMaps maps;

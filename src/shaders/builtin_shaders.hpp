@@ -143,12 +143,19 @@ struct FlatShader {
   }
 };
 
-// One-sided: the colour lit by the vertex normal, 3 varyings. Two-sided: the colours for both
-// faces (by n and by -n), 6 varyings, the fragment picks by the primitive's facing.
-template <bool kTwoSided>
+// One-sided: the colour lit by the vertex normal. Two-sided: the colours for both faces (by n
+// and by -n), the fragment picks by the primitive's facing.
+// kVertexAlbedo: the albedo is each vertex's own (the mesh's vertex colours), so the lit colour
+// is what is interpolated: 3 varyings (6 two-sided). Otherwise the albedo is the material's, one
+// colour for the draw, and the colour is that albedo times the light's intensity: the intensity
+// alone is interpolated (1 varying, 2 two-sided) and the fragment multiplies it by the albedo.
+// The same colour up to the rounding of one product (never a whole unit of an 8-bit channel in
+// practice), with a third of the planes to set up, store and interpolate.
+template <bool kTwoSided, bool kVertexAlbedo = false>
 struct GouraudShader {
-  static constexpr int kVaryings = kTwoSided ? 6 : 3;
-  // Its fragment stage copies three varyings: shading several small triangles per call (lanes
+  static constexpr int kPerFace = kVertexAlbedo ? 3 : 1;
+  static constexpr int kVaryings = kTwoSided ? 2 * kPerFace : kPerFace;
+  // Its fragment stage copies a few varyings: shading several small triangles per call (lanes
   // picking their triangle's planes) costs about what it saves. Below AVX-512 it is slower
   // (spheres_1m gouraud, one thread, AVX2: 50.7 -> 55.5 ms), at AVX-512 a little faster (43.3 ->
   // 42.7), which is where shader.hpp takes it for a kCheapToShade shader.
@@ -158,25 +165,29 @@ struct GouraudShader {
   glm::vec3 albedo;
   Lighting lighting;
   float alpha = 1.0f;
-  ColorSource colors;  // the mesh's vertex colours as the albedo, when it has them
-  glm::vec3 lit(const glm::vec3& n, const glm::vec3& base) const {
-    float d = std::max(glm::dot(n, lighting.light), 0.0f);
-    return base * (lighting.ambient + lighting.diffuse * d);
+  ColorSource colors;  // the mesh's vertex colours as the albedo (kVertexAlbedo only)
+  float intensity(const glm::vec3& n) const {
+    return lighting.ambient + lighting.diffuse * std::max(glm::dot(n, lighting.light), 0.0f);
   }
   glm::vec4 vertex(uint32_t i, float* v) const {
     glm::vec3 n = glm::normalize(in.mesh->normals[i]);
-    glm::vec3 base = colors.albedo(*in.mesh, i, albedo);
-    glm::vec3 c = lit(n, base);
-    v[0] = c.r, v[1] = c.g, v[2] = c.b;
-    if constexpr (kTwoSided) {
-      glm::vec3 back = lit(-n, base);
-      v[3] = back.r, v[4] = back.g, v[5] = back.b;
+    if constexpr (kVertexAlbedo) {
+      glm::vec3 base = colors.albedo(*in.mesh, i, albedo);
+      glm::vec3 c = base * intensity(n);
+      v[0] = c.r, v[1] = c.g, v[2] = c.b;
+      if constexpr (kTwoSided) {
+        glm::vec3 back = base * intensity(-n);
+        v[3] = back.r, v[4] = back.g, v[5] = back.b;
+      }
+    } else {
+      v[0] = intensity(n);
+      if constexpr (kTwoSided) v[1] = intensity(-n);
     }
     return in.clip(i);
   }
   // vertex() on 16 vertices: glm's normalize (v times 1 / sqrt((x x + y y) + z z)), dot and
   // std::max lane-wise, so the same bits. Vertex colours (decoded through std::pow) take vertex().
-  bool wide_vertices() const { return !colors.use; }
+  bool wide_vertices() const { return !kVertexAlbedo || !colors.use; }
   template <int N>
   SOFTRAST_SIMD_INLINE simd::Vec4<N> vertices(const Vertices<N>& vs, simd::Float<N>* v) const {
     using F = simd::Float<N>;
@@ -184,10 +195,10 @@ struct GouraudShader {
     const F inv = F(1.0f) / simd::sqrt((m.x * m.x + m.y * m.y) + m.z * m.z);
     const simd::Vec3<N> n = {m.x * inv, m.y * inv, m.z * inv};
     lit_wide<N>(n, v);
-    if constexpr (kTwoSided) lit_wide<N>({-n.x, -n.y, -n.z}, v + 3);
+    if constexpr (kTwoSided) lit_wide<N>({-n.x, -n.y, -n.z}, v + kPerFace);
     return in.clip(vs);
   }
-  // lit() with the material's albedo, to three varyings.
+  // intensity() (times the material's albedo, kVertexAlbedo) to kPerFace varyings.
   template <int N>
   SOFTRAST_SIMD_INLINE void lit_wide(const simd::Vec3<N>& n, simd::Float<N>* v) const {
     using F = simd::Float<N>;
@@ -195,12 +206,22 @@ struct GouraudShader {
     F d = (n.x * F(l.x) + n.y * F(l.y)) + n.z * F(l.z);
     d = simd::select(d < F(0.0f), F(0.0f), d);  // std::max(d, 0.0f)
     const F s = F(lighting.ambient) + F(lighting.diffuse) * d;
-    v[0] = F(albedo.r) * s, v[1] = F(albedo.g) * s, v[2] = F(albedo.b) * s;
+    if constexpr (kVertexAlbedo) {
+      v[0] = F(albedo.r) * s, v[1] = F(albedo.g) * s, v[2] = F(albedo.b) * s;
+    } else {
+      v[0] = s;
+    }
   }
   template <int N>
   SOFTRAST_SIMD_INLINE void shade(Fragments<N>& f) const {
-    int first = kTwoSided && !f.front_facing ? 3 : 0;
-    f.color = {f.varying(first), f.varying(first + 1), f.varying(first + 2), alpha};
+    const int first = kTwoSided && !f.front_facing ? kPerFace : 0;
+    if constexpr (kVertexAlbedo) {
+      f.color = {f.varying(first), f.varying(first + 1), f.varying(first + 2), alpha};
+    } else {
+      using F = simd::Float<N>;
+      const F s = f.varying(first);
+      f.color = {F(albedo.r) * s, F(albedo.g) * s, F(albedo.b) * s, alpha};
+    }
     if (lighting.srgb_output) f.color = encode_srgb<N>(f.color);
   }
 };

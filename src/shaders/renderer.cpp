@@ -120,20 +120,29 @@ void draw_run(Framebuffer& fb, const RenderState& state, const Mesh& mesh, const
       if (colors.use) {  // unlit, interpolated: Gouraud with the ambient term alone, at 1
         Lighting unlit = lighting;
         unlit.ambient = 1.0f, unlit.diffuse = 0.0f;
-        return draw(fb, state, GouraudShader<false>{in, surf.albedo, unlit, opt.alpha, colors},
-                    indices, n);
+        return draw(fb, state,
+                    GouraudShader<false, true>{in, surf.albedo, unlit, opt.alpha, colors}, indices,
+                    n);
       }
       return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, opt.alpha), opt.srgb}, indices,
                   n);
     case ShaderKind::kWireframe:  // the overlay passes the wire colour as the surface albedo
       return draw(fb, state, FlatShader{in, glm::vec4(surf.albedo, 1.0f)}, indices, n);
-    case ShaderKind::kGouraud:
-      if (two_sided) {
-        return draw(fb, state, GouraudShader<true>{in, surf.albedo, lighting, opt.alpha, colors},
-                    indices, n);
+    case ShaderKind::kGouraud: {
+      // The mesh's vertex colours as the albedo: the lit colour interpolated; else the intensity.
+      auto gouraud = [&]<bool kTwoSided, bool kVertexAlbedo>() {
+        return draw(
+            fb, state,
+            GouraudShader<kTwoSided, kVertexAlbedo>{in, surf.albedo, lighting, opt.alpha, colors},
+            indices, n);
+      };
+      if (colors.use) {
+        return two_sided ? gouraud.template operator()<true, true>()
+                         : gouraud.template operator()<false, true>();
       }
-      return draw(fb, state, GouraudShader<false>{in, surf.albedo, lighting, opt.alpha, colors},
-                  indices, n);
+      return two_sided ? gouraud.template operator()<true, false>()
+                       : gouraud.template operator()<false, false>();
+    }
     case ShaderKind::kTexture: {
       const Texture* t = surf.texture ? surf.texture : &kWhite;
       return draw(fb, state, TextureShader{in, SampledTexture(*t, sampler), opt.alpha, opt.srgb},
