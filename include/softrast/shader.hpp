@@ -27,10 +27,10 @@
 // and a 4x4 block whose pixels several triangles cover is then shaded in one call, each pixel
 // with its own triangle's varyings (a 2x2 quad may mix triangles, so ddx and ddy would be
 // meaningless there: they stop the program with a message if called after all). A shader whose
-// fragment work is only a few operations (the built-in Gouraud copies its varyings) gains little
+// fragment work is only a few operations (the built-in Gouraud scales one varying) gains little
 // from that, since picking each pixel's triangle costs about as much; it may say so with
 //   static constexpr bool kCheapToShade = true;
-// and is then shaded that way only at AVX-512 (16 lanes to fill, and a permute per coefficient)
+// and is then shaded that way only at AVX-512 (16 lanes to fill, and a broadcast per coefficient)
 // and only in tiles shaded as their triangles come (the held blocks of a dense mesh), one
 // triangle per call elsewhere.
 // A scalar shader is taken to discard (it returns a bool) and is always shaded immediately.

@@ -156,10 +156,11 @@ template <bool kTwoSided, bool kVertexAlbedo = false>
 struct GouraudShader {
   static constexpr int kPerFace = kVertexAlbedo ? 3 : 1;
   static constexpr int kVaryings = kTwoSided ? 2 * kPerFace : kPerFace;
-  // Its fragment stage copies a few varyings: shading several small triangles per call (lanes
+  // Its fragment stage is a few products: shading several small triangles per call (lanes
   // picking their triangle's planes) costs about what it saves. Below AVX-512 it is slower
-  // (spheres_1m gouraud, one thread, AVX2: 50.7 -> 55.5 ms), at AVX-512 a little faster (43.3 ->
-  // 42.7), which is where shader.hpp takes it for a kCheapToShade shader.
+  // (spheres_1m gouraud, one thread, AVX2: 50.7 -> 55.5 ms with three varyings, 49.0 -> 52.0 with
+  // one), at AVX-512 faster (43.3 -> 42.7 ms with three), which is where shader.hpp takes it for
+  // a kCheapToShade shader.
   static constexpr bool kCheapToShade = true;
   bool reads_derivatives() const { return false; }
   MeshInputs in;
