@@ -61,9 +61,11 @@ Soup random_soup(int count, unsigned seed) {
   return soup;
 }
 
-// threads = 0 draws with the reference path.
-std::vector<uint32_t> render_soup(const Soup& soup, RenderState state, int threads) {
-  Framebuffer fb(301, 187);  // not a multiple of the tile size
+// threads = 0 draws with the reference path. The default size is not a multiple of the tile
+// size.
+std::vector<uint32_t> render_soup(const Soup& soup, RenderState state, int threads, int width = 301,
+                                  int height = 187) {
+  Framebuffer fb(width, height);
   state.threads = threads;
   state.reference_path = threads == 0;
   SoupShader shader{soup.positions.data(), soup.colors.data()};
@@ -90,6 +92,33 @@ TEST(Threading, BlendedSoupIsIdenticalForEveryThreadCount) {
         EXPECT_TRUE(render_soup(soup, state, threads) == reference)
             << "blend " << int(blend) << " raster " << int(raster) << " threads " << threads;
       }
+    }
+  }
+}
+
+// The binned path keeps its bins and arenas from draw to draw on a thread, and clears only the
+// tiles a chunk's last draw reached: draws of other scenes, other sizes (more tiles, then fewer,
+// then more again) and other states on the same thread must leave nothing behind for the next.
+TEST(Threading, DrawsAfterOtherSizesAndScenesMatchTheReference) {
+  const Soup many = random_soup(40000, 11), few = random_soup(300, 12);
+  RenderState opaque;  // deferrable: the tiles' box areas are summed too
+  opaque.cull = CullMode::kNone;
+  RenderState blended = opaque;
+  blended.depth_test = false;
+  blended.blend = BlendMode::kAlpha;
+  struct Step {
+    const Soup* soup;
+    const RenderState* state;
+    int width, height;
+  };
+  const Step steps[] = {{&many, &opaque, 701, 517},  {&few, &blended, 61, 40},
+                        {&many, &blended, 301, 187}, {&few, &opaque, 701, 517},
+                        {&many, &opaque, 130, 700},  {&few, &blended, 701, 517}};
+  for (int threads : {1, 2}) {
+    for (const Step& step : steps) {
+      EXPECT_TRUE(render_soup(*step.soup, *step.state, threads, step.width, step.height) ==
+                  render_soup(*step.soup, *step.state, 0, step.width, step.height))
+          << step.width << "x" << step.height << " threads " << threads;
     }
   }
 }

@@ -75,6 +75,11 @@ constexpr size_t kPrefetchStep = 4;
 struct alignas(64) Chunk {
   RecordArena records;
   std::vector<std::vector<uint32_t>> bins;  // per tile: offsets of its records in `records`
+  // The tiles whose bins hold records, in the order they got their first (capacity: every tile,
+  // so it never grows during a draw). A batch of small triangles reaches a few dozen of the
+  // image's tiles: clearing the bins and listing the batch's tiles visit these alone, not every
+  // bin of every chunk (BinnedDraw::order_tiles).
+  std::vector<uint32_t> touched;
   // Per tile (deferrable draws): the area of its records' bounding boxes clipped to it.
   std::vector<int64_t> box_area;
   size_t place = 0;  // the thread that set it up (parallel_slot)
@@ -104,6 +109,10 @@ struct DrawCache {
   // Per thread place (run_phase): the tiles it takes first, busiest first, and its counters.
   std::vector<std::vector<uint32_t>> place_tiles;
   std::vector<size_t> place_records;  // scratch: a tile's records set up by each place
+  // order_tiles: per tile, the last listing that took it (a tile touched by several chunks is
+  // listed once), and that listing's number.
+  std::vector<uint32_t> tile_listed;
+  uint32_t listing = 0;
   std::unique_ptr<PlaceCounters[]> counters;
   size_t num_counters = 0;
 };
@@ -173,10 +182,13 @@ class BinnedDraw {
     // The cache keeps the most chunks any draw used (one thread needs one), so alternating
     // thread counts does not free and reallocate arenas.
     if (cache_.chunks.size() < sets * num_chunks_) cache_.chunks.resize(sets * num_chunks_);
+    const size_t tiles = size_t(tiles_x_) * size_t(tiles_y_);
     for (size_t c = 0; c < sets * num_chunks_; ++c) {
-      cache_.chunks[c].bins.resize(size_t(tiles_x_) * size_t(tiles_y_));
-      cache_.chunks[c].box_area.resize(deferred_ ? size_t(tiles_x_) * size_t(tiles_y_) : 0);
+      cache_.chunks[c].bins.resize(tiles);
+      cache_.chunks[c].touched.reserve(tiles);
+      cache_.chunks[c].box_area.resize(deferred_ ? tiles : 0);
     }
+    if (cache_.tile_listed.size() < tiles) cache_.tile_listed.resize(tiles, cache_.listing);
     auto setup_of = [&](size_t b) {
       SetupJobs jobs;
       jobs.indices = indices;
@@ -211,8 +223,13 @@ class BinnedDraw {
   // Phase 1 for one chunk.
   void setup_chunk(Chunk& chunk, const uint32_t* indices, size_t begin, size_t end) {
     chunk.records.clear();
-    for (std::vector<uint32_t>& bin : chunk.bins) bin.clear();
-    std::fill(chunk.box_area.begin(), chunk.box_area.end(), 0);
+    // Only the tiles it touched last time hold anything (those past a smaller image's tiles went
+    // with the resize; box_area is summed where records are binned, in the same tiles).
+    for (uint32_t tile : chunk.touched) {
+      if (tile < chunk.bins.size()) chunk.bins[tile].clear();
+      if (tile < chunk.box_area.size()) chunk.box_area[tile] = 0;
+    }
+    chunk.touched.clear();
     auto add = [&](const WindowVertex& a, const WindowVertex& b, const WindowVertex& c) {
       add_triangle(chunk, a, b, c);
     };
@@ -351,7 +368,7 @@ class BinnedDraw {
       } else if (box_area) {
         bin_in_tile(chunk, tiles.tile[l], bounds(), offset);
       } else {
-        chunk.bins[tiles.tile[l]].push_back(offset);
+        push(chunk, tiles.tile[l], offset);
       }
       offset += uint32_t(record_bytes_);
     }
@@ -432,9 +449,16 @@ class BinnedDraw {
     bin_in_tile(chunk, size_t(ty0) * tiles_x_ + tx0, bounds, offset);
   }
 
+  // A record's offset into tile `tile`'s bin (Chunk::touched lists the tile on its first).
+  static void push(Chunk& chunk, size_t tile, uint32_t offset) {
+    std::vector<uint32_t>& bin = chunk.bins[tile];
+    if (bin.empty()) chunk.touched.push_back(uint32_t(tile));
+    bin.push_back(offset);
+  }
+
   // bin() for a triangle whose bounds lie in one tile.
   void bin_in_tile(Chunk& chunk, size_t tile, const PixelRect& bounds, uint32_t offset) {
-    chunk.bins[tile].push_back(offset);
+    push(chunk, tile, offset);
     if (!chunk.box_area.empty()) {
       chunk.box_area[tile] += int64_t(bounds.x1 - bounds.x0) * (bounds.y1 - bounds.y0);
     }
@@ -444,7 +468,7 @@ class BinnedDraw {
   [[gnu::noinline]] void bin_tiles(Chunk& chunk, const PixelRect& bounds, uint32_t offset, int tx0,
                                    int ty0, int tx1, int ty1) {
     for (int ty = ty0; ty <= ty1; ++ty) {
-      for (int tx = tx0; tx <= tx1; ++tx) chunk.bins[size_t(ty) * tiles_x_ + tx].push_back(offset);
+      for (int tx = tx0; tx <= tx1; ++tx) push(chunk, size_t(ty) * tiles_x_ + tx, offset);
     }
     if (chunk.box_area.empty()) return;
     // The bounds lie inside the scissor, so clipped to the tile they are clipped to its region.
@@ -568,18 +592,30 @@ class BinnedDraw {
     }
   }
 
-  // The tiles the batch in raster_chunks_ touches, into cache_.tile_order. With several workers
-  // the tiles with the most records come first, so that the last tiles taken are short ones and
-  // no worker is left alone with a long tile at the end of the phase.
+  // The tiles the batch in raster_chunks_ touches, into cache_.tile_order, in tile order; with
+  // several workers the tiles with the most records come first, so that the last tiles taken are
+  // short ones and no worker is left alone with a long tile at the end of the phase. From the
+  // chunks' touched lists, not a scan of every tile's bin in every chunk (4,080 bins at
+  // 1920x1080 and two threads, read by the calling thread between phases while the others wait:
+  // spheres_1m gouraud, two threads, 0.43 % of the samples before, 0.11 % after).
   void order_tiles() {
     std::vector<std::pair<uint32_t, uint32_t>>& order = cache_.tile_order;
-    size_t tiles = size_t(tiles_x_) * size_t(tiles_y_);
-    for (size_t tile = 0; tile < tiles; ++tile) {
-      size_t records = 0;
-      for (const Chunk& chunk : chunks()) records += chunk.bins[tile].size();
-      if (records != 0) order.emplace_back(uint32_t(~std::bit_width(records)), uint32_t(tile));
+    std::vector<uint32_t>& listed = cache_.tile_listed;
+    if (++cache_.listing == 0) {  // the numbers wrapped: no tile may look listed already
+      std::fill(listed.begin(), listed.end(), 0);
+      cache_.listing = 1;
     }
-    if (threads_ > 1) std::sort(order.begin(), order.end());
+    const uint32_t now = cache_.listing;
+    for (const Chunk& chunk : chunks()) {
+      for (uint32_t tile : chunk.touched) {
+        if (listed[tile] == now) continue;
+        listed[tile] = now;
+        size_t records = 0;
+        for (const Chunk& c : chunks()) records += c.bins[tile].size();
+        order.emplace_back(threads_ > 1 ? uint32_t(~std::bit_width(records)) : 0u, tile);
+      }
+    }
+    std::sort(order.begin(), order.end());
   }
 
   void raster_tile_job(size_t tile, size_t worker, TilePrefetch& ahead) {
