@@ -30,6 +30,11 @@
 namespace softrast {
 namespace {
 
+// The largest bounds, in pixels, of a triangle whose coverage the SIMD setup finds (a speck, when
+// its vertices also span at most 6 pixels): it drops those that cover no pixel and gives the
+// others' blocks (TriRecord::blocks).
+constexpr int kSpeckPixels = 5;
+
 // Clip-space vertices (x, y, z, w, kKernelVaryings varyings): mostly inside the view, and some of
 // each kind the front end treats apart: beyond the guard band, behind the eye, NaN and Inf,
 // exactly on planes, snapped onto the same point (zero area), triangles larger than the 32-bit
@@ -215,21 +220,21 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
                   ++checked_none;
                   continue;
                 }
-                if (want.bounds.x1 - want.bounds.x0 <= 4 && want.bounds.y1 - want.bounds.y0 <= 4 &&
-                    sample_on_an_edge(want)) {
+                if (want.bounds.x1 - want.bounds.x0 <= kSpeckPixels &&
+                    want.bounds.y1 - want.bounds.y0 <= kSpeckPixels && sample_on_an_edge(want)) {
                   ++checked_on_edge;  // kept or dropped below by the fill rule's decision
                 }
                 if (!ready) {
-                  // Dropped by the kernel: bounds of at most 4x4 pixels, no sample covered.
-                  EXPECT_LE(want.bounds.x1 - want.bounds.x0, 4);
-                  EXPECT_LE(want.bounds.y1 - want.bounds.y0, 4);
+                  // Dropped by the kernel: bounds of at most 5x5 pixels, no sample covered.
+                  EXPECT_LE(want.bounds.x1 - want.bounds.x0, kSpeckPixels);
+                  EXPECT_LE(want.bounds.y1 - want.bounds.y0, kSpeckPixels);
                   ASSERT_FALSE(covers_a_pixel(want));
                   ++checked_dropped;
                   continue;
                 }
                 // Kept: only triangles that cover a pixel, wherever the test applies.
-                const bool speck = want.bounds.x1 - want.bounds.x0 <= 4 &&
-                                   want.bounds.y1 - want.bounds.y0 <= 4 &&
+                const bool speck = want.bounds.x1 - want.bounds.x0 <= kSpeckPixels &&
+                                   want.bounds.y1 - want.bounds.y0 <= kSpeckPixels &&
                                    std::max({want.vx[0], want.vx[1], want.vx[2]}) -
                                            std::min({want.vx[0], want.vx[1], want.vx[2]}) <=
                                        6 * detail::kSubpixelOne &&

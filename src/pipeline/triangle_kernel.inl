@@ -416,16 +416,19 @@ void select_triangles(const TriangleBatch& b, size_t first, int count, TriangleL
   I edge_a[3], edge_b[3], bias[3];
   for (int k = 0; k < 3; ++k) lane_edge(vx, vy, k, edge_a[k], edge_b[k], bias[k]);
 
-  // A triangle whose bounds are at most 4x4 pixels and whose edges pass no sample inside them
+  // A triangle whose bounds are at most 5x5 pixels and whose edges pass no sample inside them
   // (a sliver or a speck between pixel centres: a sixth of spheres_1m's records) covers no pixel:
-  // it is dropped here, before its record, planes and bins are made. Its samples are tested as
-  // the tile kernels test them: E = a x + b y + c at the sample, covered when all three are >= 0.
-  // Edge k's c is bias - (a xk + b yk), with vertex k's xk and yk, so E is
-  // a (x - xk) + b (y - yk) + bias, exactly, in int32: the vertices span at most 6 pixels (1536
-  // in 1/256), so |a|, |b| <= 1536, and the 16 samples lie within 2304 of every vertex:
-  // |E| <= 2 * 1536 * 2304 < 2^23.
+  // it is dropped here, before its record, planes and bins are made. The others keep the coverage
+  // found here (TriRecord::blocks), which the tile kernels take as it is. Bounds of 5 pixels fit
+  // the 2x2 blocks from their first pixel's block wherever they start in it (3 + 5 <= 8); on
+  // spheres_1m, bounds of 5 are three quarters of the triangles that 4 left to the edge tests.
+  // Its samples are tested as the tile kernels test them: E = a x + b y + c at the sample,
+  // covered when all three are >= 0. Edge k's c is bias - (a xk + b yk), with vertex k's xk and
+  // yk, so E is a (x - xk) + b (y - yk) + bias, exactly, in int32: the vertices span at most 6
+  // pixels (1536 in 1/256), so |a|, |b| <= 1536, and the 25 samples lie within 2304 of every
+  // vertex: |E| <= 2 * 1536 * 2304 < 2^23.
   const I width = bx1 - bx0, height = by1 - by0;
-  const I speck = kept & inside & (width <= 4) & (height <= 4) &
+  const I speck = kept & inside & (width <= 5) & (height <= 5) &
                   (bounds.width_fx8 <= 6 * kSubpixelOne) & (bounds.height_fx8 <= 6 * kSubpixelOne);
   if (lane_bits(speck) != 0) {
     // Every value below is 0 in the other lanes (unused; no overflow there).
@@ -438,35 +441,42 @@ void select_triangles(const TriangleBatch& b, size_t first, int count, TriangleL
       step_x[k] = a * kSubpixelOne;
       step_y[k] = b * kSubpixelOne;
     }
-    // The samples outside as bits 8 row + column (the bounds' 4x4 pixels in the first four bits
-    // of four bytes, rows of an 8x8 area of pixels): the sign bits of the or of the three values,
-    // shifted in from the last sample to the first, with four more shifts between rows (the
-    // bits 4 to 7 of each byte). Samples past the bounds are tested too, and cut after.
-    U outside = U{};
-    for (int k = 0; k < 3; ++k) e[k] += 3 * step_x[k] + 3 * step_y[k];  // the last sample
-    for (int row = 3; row >= 0; --row) {
+    // The samples outside as bits 8 row + column (the bounds' 5x5 pixels in the first five bits
+    // of five bytes, rows of an 8x8 area of pixels): rows 0 to 3 in `outside`, row 4 in
+    // `outside4`. Each row's bits are the sign bits of the or of the three values, shifted in
+    // from its last sample to its first. Samples past the bounds are tested too, and cut after.
+    U outside = U{}, outside4 = U{};
+    for (int k = 0; k < 3; ++k) e[k] += 4 * step_x[k] + 4 * step_y[k];  // the last sample
+    for (int row = 4; row >= 0; --row) {
       I c[3] = {e[0], e[1], e[2]};
-      for (int column = 3; column >= 0; --column) {
-        outside = (outside << 1) | (U(c[0] | c[1] | c[2]) >> 31);
+      U bits = U{};
+      for (int column = 4; column >= 0; --column) {
+        bits = (bits << 1) | (U(c[0] | c[1] | c[2]) >> 31);
         for (int k = 0; k < 3; ++k) c[k] -= step_x[k];
       }
-      if (row > 0) outside <<= 4;
+      if (row == 4) {
+        outside4 = bits;
+      } else {
+        outside = (outside << 8) | bits;
+      }
       for (int k = 0; k < 3; ++k) e[k] -= step_y[k];
     }
-    I covered = I(~outside);
-    // The bounds: `width` bits of each of `height` bytes (both 1 to 4 in specks; 4 elsewhere, to
-    // keep the shift counts in range).
-    const U columns = (U{} + 0xffu) >> U(8 - (speck ? width : 4));
-    const U rows = (U{} + 0xffffffffu) >> U(32 - 8 * (speck ? height : 4));
-    covered &= I((columns | columns << 8 | columns << 16 | columns << 24) & rows);
+    // The bounds: `width` bits of each of `height` bytes (both 1 to 5 in specks; 5 and 4
+    // elsewhere, to keep the shift counts in range).
+    const U columns = (U{} + 0xffu) >> U(8 - (speck ? width : 5));
+    const U rows = (U{} + 0xffffffffu) >> U(32 - 8 * (speck & (height < 4) ? height : 4));
+    I covered = I(~outside & (columns | columns << 8 | columns << 16 | columns << 24) & rows);
     covered &= speck;
-    out.ready &= ~lane_bits(speck & ~(covered != 0));
+    const I covered4 = I(~outside4 & columns) & (speck & (height == 5));
+    out.ready &= ~lane_bits(speck & ~((covered | covered4) != 0));
     // The same bits as blocks (TriRecord::blocks): the 8x8 area moved to the first of the 2x2
     // blocks that hold the bounds (by 8 rows + columns of the bounds' offset in its block), as
     // two halves of 32 bits, rows 0 to 3 and rows 4 to 7; each half's left and right 4x4 block.
+    // Row 4 of the bounds lands in the lower half, at row (by0 & 3) of it.
     const U shift = U((by0 & 3) * 8 + (bx0 & 3));  // at most 27
     const U upper = U(covered) << shift;
-    const U lower = (U(covered) >> 1) >> (31 - shift);  // what moved past bit 31 (0 if nothing)
+    // What moved past bit 31 (0 if nothing), and row 4.
+    const U lower = ((U(covered) >> 1) >> (31 - shift)) | (U(covered4) << shift);
     const U top = block_pair(upper), bottom = block_pair(lower);
     std::memcpy(out.blocks[0], &top, sizeof top);
     std::memcpy(out.blocks[1], &bottom, sizeof bottom);

@@ -54,7 +54,7 @@ struct TriangleLanes {
   alignas(64) int64_t edge_c[3][kMaxLanes];   // EdgeFunction::c
   alignas(64) int64_t area[kMaxLanes];        // signed_area_fx16 of the triangle as submitted
   alignas(64) int32_t bounds[4][kMaxLanes];   // x0, y0, x1, y1 (PixelRect)
-  // TriRecord::blocks: a speck's coverage by block (bounds of at most 4x4 pixels), else 0.
+  // TriRecord::blocks: a speck's coverage by block (bounds of at most 5x5 pixels), else 0.
   alignas(64) uint32_t blocks[2][kMaxLanes];  // its low and high 32 bits
   // The Interpolants of the ready lanes but those in `scalar_planes`: a vertex's 1/w is outside
   // [2^-20, 2^20], where setup rescales it (rare: a scene in tiny or huge units), and the scalar

@@ -22,7 +22,7 @@ namespace softrast::detail {
 struct TriRecord {
   EdgeFunction edge[3];  // TriangleCoverage::edge
   PixelRect bounds;      // TriangleCoverage::bounds
-  // The coverage of a speck (bounds of at most 4x4 pixels), where the SIMD setup computed it on
+  // The coverage of a speck (bounds of at most 5x5 pixels), where the SIMD setup computed it on
   // its way to dropping the specks that cover nothing: the masks of the 2x2 blocks from (bounds.x0
   // & ~3, bounds.y0 & ~3), 16 bits each (bit 4 row + column, the tile kernels' masks) in the
   // order top left, top right, bottom left, bottom right. 0: not computed (the scalar setup, a
