@@ -152,7 +152,7 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
     }
   }
   int checked_ready = 0, checked_scalar = 0, checked_none = 0, checked_dropped = 0,
-      checked_rescaled = 0, checked_on_edge = 0, checked_blocks = 0;
+      checked_rescaled = 0, checked_on_edge = 0, checked_blocks = 0, checked_blocks5 = 0;
   int levels = 0;  // levels checked: the counts below are sums over them
   for (SimdLevel level : {SimdLevel::kAvx2, SimdLevel::kAvx512}) {
     if (cpu_simd_level() < level) continue;
@@ -268,6 +268,8 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
                   const detail::PixelRect& b = want.bounds;
                   EXPECT_EQ(blocks, test::rule_block_masks(rule, b.x0, b.y0, b.x1, b.y1));
                   ++checked_blocks;
+                  // (Bounds of 5 pixels: the fifth row or column of the speck test.)
+                  if (std::max(b.x1 - b.x0, b.y1 - b.y0) == kSpeckPixels) ++checked_blocks5;
                 } else {
                   EXPECT_EQ(blocks, 0u);
                 }
@@ -325,6 +327,7 @@ TEST(TriangleKernel, EqualsTheScalarFrontEnd) {
   EXPECT_GT(checked_rescaled, 50 * levels);
   EXPECT_GT(checked_on_edge, 50 * levels);
   EXPECT_GT(checked_blocks, 1000 * levels);
+  EXPECT_GT(checked_blocks5, 100 * levels);
 }
 
 // The kernel in the steps the binned draw gathers with (AVX-512): each group's select, its ready
