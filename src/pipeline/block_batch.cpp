@@ -13,9 +13,7 @@ void BlockBatch::add_with_shading(const Interpolants& in, int x, int y, uint32_t
     return;
   }
   if (same_block && (slot.covered & mask) == 0 && held.front_facing == in.front_facing) {
-    held.winner[held.count] = &in;  // it completes the block: nothing more can join
-    held.mask[held.count++] = mask;
-    slot.covered |= mask;
+    join(slot, in, mask);  // it completes the block: nothing more can join
     shade(index);
     return;
   }

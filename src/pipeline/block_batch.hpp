@@ -36,10 +36,12 @@ class BlockBatch {
   }
   // The pixels `mask` of the block at (x, y), covered by the triangle of `in`: held for a call
   // with other triangles' pixels of that block, or shaded now if they are the whole block (after
-  // the block's held pixels, if any). Inline in the tile kernels: the usual cases (a whole block
-  // where nothing is held, an empty slot taking a block, a held block gaining pixels that leave
-  // it incomplete) are a few tests and stores, or one call to the fragment stage (spheres_1m
-  // gouraud, one thread: 40.24 -> 39.85 ms, against add and its slot cases as two calls).
+  // the block's held pixels, if any). In the header, for the tile kernels to inline: the usual
+  // cases (a whole block where nothing is held, an empty slot taking a block, a held block gaining
+  // pixels that leave it incomplete) are a few tests and stores, or one call to the fragment stage
+  // (spheres_1m gouraud, one thread: 40.24 -> 39.85 ms, against add and its slot cases as two
+  // calls). GCC still keeps it out of line at some call sites, the specks' among them; forcing it
+  // inline there measured slower (38.25 -> 38.54 ms).
   void add(const Interpolants& in, int x, int y, uint32_t mask) {
     const int index = slot_index(x, y);
     Slot& slot = slots_[index];
@@ -54,10 +56,7 @@ class BlockBatch {
     }
     if (slot.x == x && slot.y == y && (slot.covered & mask) == 0 &&
         held.front_facing == in.front_facing && (slot.covered | mask) != 0xffffu) {
-      // (A whole block never joins: the slot holds pixels.)
-      held.winner[held.count] = &in;
-      held.mask[held.count++] = mask;  // at most 15 here: the masks are disjoint and not empty
-      slot.covered |= mask;
+      join(slot, in, mask);  // (a whole block never joins: the slot holds pixels)
       return;
     }
     add_with_shading(in, x, y, mask, index);
@@ -94,6 +93,12 @@ class BlockBatch {
     slot.block.mask[0] = mask;
     slot.block.count = 1;
     held_[index >> 6] |= uint64_t(1) << (index & 63);
+  }
+  // The held block of `slot` gains the pixels `mask` (disjoint from its own) of `in`'s triangle.
+  static void join(Slot& slot, const Interpolants& in, uint32_t mask) {
+    slot.block.winner[slot.block.count] = &in;
+    slot.block.mask[slot.block.count++] = mask;  // at most 16: the masks are disjoint, not empty
+    slot.covered |= mask;
   }
   void shade(int slot);
 
