@@ -38,12 +38,19 @@ void collect(void* context, int x, int y, uint32_t mask) {
 }
 
 // One record in an arena, as the binned draw makes it; with `blocks`, a speck's coverage by block
-// as the SIMD setup gives it (TriRecord::blocks).
+// as the SIMD setup gives it (TriRecord::blocks), and no edges: the bytes before its header, where
+// a record with edges has them, are garbage that no kernel may use.
 struct OneRecord {
-  alignas(8) std::byte bytes[detail::record_bytes(0)];
+  static constexpr uint32_t kOffset = sizeof(detail::RecordEdges);  // the header's
+  alignas(8) std::byte bytes[kOffset + detail::record_bytes(0)];
+  detail::TriRecord* header() { return reinterpret_cast<detail::TriRecord*>(bytes + kOffset); }
   OneRecord(const detail::TriangleSetup& tri, uint64_t blocks) {
-    auto* rec = new (bytes) detail::TriRecord;
-    for (int k = 0; k < 3; ++k) rec->edge[k] = tri.edge[k];
+    auto* rec = new (bytes + kOffset) detail::TriRecord;
+    if (blocks != 0) {
+      std::memset(bytes, 0x5a, kOffset);
+    } else {
+      rec->set_edges(tri.edge);
+    }
     rec->bounds = tri.bounds;
     rec->blocks = blocks;
     auto extent = [](const int32_t v[3]) {
@@ -81,7 +88,7 @@ bool agrees(const detail::WindowVertex v[3], int width, int height) {
 
 bool agrees(const detail::TriangleSetup& tri, const PixelRect& scissor, uint64_t blocks) {
   OneRecord record(tri, blocks);
-  uint32_t offset = 0;
+  uint32_t offset = OneRecord::kOffset;
   for (int level = 0; level <= int(cpu_simd_level()); ++level) {
     detail::TileKernels kernels = detail::tile_kernels(SimdLevel(level));
     for (int ty = tri.bounds.y0 / 64; ty <= (tri.bounds.y1 - 1) / 64; ++ty) {
@@ -99,9 +106,8 @@ bool agrees(const detail::TriangleSetup& tri, const PixelRect& scissor, uint64_t
         kernels.immediate(job, record.bytes, &offset, 1);
         if (got != expected) {
           ADD_FAILURE() << "level " << simd_level_name(SimdLevel(level)) << " tile " << tx << ","
-                        << ty << " small "
-                        << reinterpret_cast<detail::TriRecord*>(record.bytes)->small << " blocks "
-                        << blocks << " scissor " << scissor.x0 << "," << scissor.y0 << " vertices ("
+                        << ty << " small " << record.header()->small << " blocks " << blocks
+                        << " scissor " << scissor.x0 << "," << scissor.y0 << " vertices ("
                         << tri.vx[0] << "," << tri.vy[0] << ") (" << tri.vx[1] << "," << tri.vy[1]
                         << ") (" << tri.vx[2] << "," << tri.vy[2] << ")";
           return false;

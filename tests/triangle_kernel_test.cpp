@@ -497,7 +497,7 @@ TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
   constexpr int kLanes = detail::TriangleLanes::kMaxLanes;
   constexpr size_t kRoom = sizeof(detail::TriRecord) + sizeof(detail::Interpolants) + 64;
   constexpr unsigned char kGuard = 0xa5;
-  int compared = 0, front = 0, back = 0, binned = 0, spanning = 0;
+  int compared = 0, front = 0, back = 0, binned = 0, spanning = 0, with_edge_bytes = 0;
   for (int round = 0; round < 40; ++round) {
     auto lanes = std::make_unique<detail::TriangleLanes>();
     fill(lanes.get(), sizeof(detail::TriangleLanes));
@@ -515,6 +515,10 @@ TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
       if (l % 7 == round % 7) lanes->area[l] = -int64_t(rng() % 1000) - 1;
       if (l % 3 == round % 3) lanes->area[l] = int64_t(rng() % 1000) + 1;
     }
+    // Specks with blocks (records without edges) and other triangles (blocks 0: with edges).
+    for (int l = 0; l < kLanes; ++l) {
+      if (l % 3 != round % 3) lanes->blocks[0][l] = lanes->blocks[1][l] = 0;
+    }
     lanes->ready = uint32_t(rng()) | 1u;
     lanes->scalar_planes = 0;
     for (int count : {8, 16}) {
@@ -524,19 +528,26 @@ TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
           // The ready lanes' records back to back in lane order, as the binned draw places them
           // (from an offset of 8 bytes in odd rounds), the others in scratch room; guard bytes
           // around both.
+          // A ready lane without blocks has its edges just before its header.
           std::vector<unsigned char> room(kLanes * kRoom, kGuard), scratch(2 * kRoom, kGuard);
           unsigned char* const base = room.data() + 64 + 8 * (round % 2);
           unsigned char* const scratch_at = scratch.data() + 64;
+          constexpr size_t kEdgeBytes = sizeof(detail::RecordEdges);
           std::byte* dest[kLanes];
+          std::byte* edges[kLanes];
+          bool with_edges[kLanes];
           size_t used = 0;
           for (int l = 0; l < kLanes; ++l) {
             const bool ready = (lanes->ready >> l) & 1u;
+            with_edges[l] = ready && (lanes->blocks[0][l] | lanes->blocks[1][l]) == 0;
+            edges[l] = reinterpret_cast<std::byte*>(with_edges[l] ? base + used : scratch_at);
+            used += with_edges[l] ? kEdgeBytes : 0;
             dest[l] = reinterpret_cast<std::byte*>(ready ? base + used : scratch_at);
             used += ready ? bytes : 0;
           }
           detail::GroupTiles tiles;
           const int tiles_x = 1 + round % 31;
-          detail::write_records(*lanes, count, num_varyings, face, dest, tiles_x, tiles);
+          detail::write_records(*lanes, count, num_varyings, face, dest, edges, tiles_x, tiles);
           // Nothing written before the first record, or past kRecordSlack after the last, or
           // around the scratch room.
           size_t last_end = 0;
@@ -558,12 +569,16 @@ TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
             SCOPED_TRACE(::testing::Message() << "lane " << l << " of " << count << ", "
                                               << num_varyings << " varyings, face " << int(face));
             alignas(64) unsigned char expected[kRoom] = {};
-            auto* rec = reinterpret_cast<detail::TriRecord*>(expected);
+            auto* rec = reinterpret_cast<detail::TriRecord*>(expected + kEdgeBytes);
             detail::write_coverage(*lanes, l, rec);
             detail::write_planes(*lanes, l, num_varyings, face, rec->interp());
             (rec->interp().front_facing ? front : back) += 1;
             // The padding bytes of `expected` are zeros: its fields were written into zeros.
-            ASSERT_EQ(std::memcmp(expected, dest[l], bytes), 0);
+            ASSERT_EQ(std::memcmp(expected + kEdgeBytes, dest[l], bytes), 0);
+            if (with_edges[l]) {
+              ASSERT_EQ(std::memcmp(expected, edges[l], kEdgeBytes), 0);
+              ++with_edge_bytes;
+            }
             // The bins: the tile of the top-left pixel, and whether the bounds leave it (bounds of
             // ready lanes lie inside the image: no negative coordinate).
             const detail::PixelRect& b = rec->bounds;
@@ -582,6 +597,8 @@ TEST(TriangleKernel, TransposedRecordsEqualTheFieldByFieldRecords) {
     }
   }
   EXPECT_GT(compared, 3000);
+  EXPECT_GT(with_edge_bytes, 1000);
+  EXPECT_LT(with_edge_bytes, compared - 500);
   EXPECT_EQ(binned, compared);
   EXPECT_GT(spanning, 500);
   EXPECT_GT(binned - spanning, 500);

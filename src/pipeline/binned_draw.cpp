@@ -342,23 +342,40 @@ class BinnedDraw {
   void add_group(Chunk& chunk, const TriangleLanes& lanes, int width, std::byte* scratch) {
     int count = 0;
     for (uint32_t m = lanes.ready; m != 0; m &= m - 1) ++count;
-    const uint32_t first = chunk.records.allocate(size_t(count) * record_bytes_, kRecordSlack);
+    // The specks whose blocks the kernel found go without edges (TriRecord).
+    uint32_t with_edges = 0;
+    for (int l = 0; l < width; ++l) {
+      with_edges |= uint32_t((lanes.blocks[0][l] | lanes.blocks[1][l]) == 0) << l;
+    }
+    with_edges &= lanes.ready;
+    const size_t bytes = size_t(count) * record_bytes_ +
+                         size_t(__builtin_popcount(with_edges)) * sizeof(RecordEdges);
+    const uint32_t first = chunk.records.allocate(bytes, kRecordSlack);
     std::byte* const data = reinterpret_cast<std::byte*>(chunk.records.at(first));
     std::byte* dest[TriangleLanes::kMaxLanes];
-    for (int l = 0; l < width; ++l) dest[l] = scratch;
+    std::byte* edges[TriangleLanes::kMaxLanes];
+    for (int l = 0; l < width; ++l) dest[l] = edges[l] = scratch;
     std::byte* to = data;
+    uint32_t offsets[TriangleLanes::kMaxLanes];
     for (uint32_t todo = lanes.ready; todo != 0; todo &= todo - 1) {
-      dest[__builtin_ctz(todo)] = to;
+      const int l = __builtin_ctz(todo);
+      if ((with_edges >> l) & 1u) {
+        edges[l] = to;
+        to += sizeof(RecordEdges);
+      }
+      dest[l] = to;
+      offsets[l] = first + uint32_t(to - data);
       to += record_bytes_;
     }
     // The lines kArenaWriteAhead on, for writing: see kArenaWriteAhead.
     if (prefetch_writes_) chunk.records.prefetch_for_write(first + kArenaWriteAhead, to - data);
     GroupTiles tiles;
-    write_records(lanes, width, geometry_.num_varyings(), state_.front_face, dest, tiles_x_, tiles);
-    uint32_t offset = first;
+    write_records(lanes, width, geometry_.num_varyings(), state_.front_face, dest, edges, tiles_x_,
+                  tiles);
     const bool box_area = !chunk.box_area.empty();
     for (uint32_t todo = lanes.ready; todo != 0; todo &= todo - 1) {
       const int l = __builtin_ctz(todo);
+      const uint32_t offset = offsets[l];
       auto bounds = [&] {
         return PixelRect{lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l],
                          lanes.bounds[3][l]};
@@ -370,13 +387,18 @@ class BinnedDraw {
       } else {
         push(chunk, tiles.tile[l], offset);
       }
-      offset += uint32_t(record_bytes_);
     }
+  }
+
+  // Room for a record with its edges (TriRecord); returns the offset of its header.
+  uint32_t allocate_with_edges(Chunk& chunk) {
+    return chunk.records.allocate(sizeof(RecordEdges) + record_bytes_) +
+           uint32_t(sizeof(RecordEdges));
   }
 
   // A triangle that the SIMD kernel set up (lane l): its record, as add_triangle makes it.
   void add_set_up(Chunk& chunk, const TriangleLanes& lanes, int l) {
-    uint32_t offset = chunk.records.allocate(record_bytes_);
+    const uint32_t offset = allocate_with_edges(chunk);
     TriRecord* rec = chunk.records.at(offset);  // every field is written below
     write_coverage(lanes, l, rec);
     if (scanline_) {
@@ -418,11 +440,11 @@ class BinnedDraw {
     TriangleCoverage t;
     const WindowVertex* ordered[3];
     if (!setup_triangle_coverage(a, b, c, area, geometry_.scissor(), t, ordered)) return;
-    uint32_t offset = chunk.records.allocate(record_bytes_);
+    const uint32_t offset = allocate_with_edges(chunk);
     // TriRecord is an implicit-lifetime aggregate living in allocated bytes; every field is
     // written below.
     TriRecord* rec = chunk.records.at(offset);
-    for (int k = 0; k < 3; ++k) rec->edge[k] = t.edge[k];
+    rec->set_edges(t.edge);
     rec->bounds = t.bounds;
     auto extent = [](const int32_t v[3]) {
       return int64_t(std::max({v[0], v[1], v[2]})) - std::min({v[0], v[1], v[2]});
@@ -507,7 +529,8 @@ class BinnedDraw {
     if (jobs == 0) return;
     const size_t workers = std::min<size_t>(size_t(threads_), jobs);
     if (raster && deferred_) {
-      size_t records = 0;  // a tile holds at most every record of the batch once
+      // A tile holds at most every record of the batch once (each takes record_bytes_ or more).
+      size_t records = 0;
       for (const Chunk& c : chunks()) records += c.records.used() / record_bytes_;
       if (cache_.scratch.size() < workers) cache_.scratch.resize(workers);
       for (size_t w = 0; w < workers; ++w) {
@@ -667,10 +690,16 @@ class BinnedDraw {
           const TriRecord& rec = record(chunk, offset);
           const PixelRect& b = rec.bounds;
           const PixelRect in = intersect(b, region);
-          // Twice the area in 1/256 pixels squared: the cross product of two edges' normals.
-          double area = std::abs(double(rec.edge[0].a) * double(rec.edge[1].b) -
-                                 double(rec.edge[1].a) * double(rec.edge[0].b)) /
-                        (2.0 * kSubpixelOne * kSubpixelOne);
+          // The area in pixels: a speck's covered pixels (it has no edges), else half the cross
+          // product of two edges' normals (in 1/256 pixels).
+          double area;
+          if (rec.blocks != 0) {
+            area = double(__builtin_popcountll(rec.blocks));
+          } else {
+            const EdgeFunction e0 = rec.edge(0), e1 = rec.edge(1);
+            area = std::abs(double(e0.a) * double(e1.b) - double(e1.a) * double(e0.b)) /
+                   (2.0 * kSubpixelOne * kSubpixelOne);
+          }
           double box = double(b.x1 - b.x0) * double(b.y1 - b.y0);
           load.cover += double(in.x1 - in.x0) * double(in.y1 - in.y0) * std::min(1.0, area / box);
         }

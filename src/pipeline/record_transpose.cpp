@@ -11,10 +11,11 @@
 namespace softrast::detail {
 
 // The records' 32-bit words, as the rows below make them.
-static_assert(offsetof(TriRecord, edge) == 0 && sizeof(EdgeFunction) == 24);
-static_assert(offsetof(TriRecord, bounds) == 72 && sizeof(PixelRect) == 16);
-static_assert(offsetof(TriRecord, blocks) == 88 && offsetof(TriRecord, small) == 96);
-static_assert(sizeof(TriRecord) == 104);
+static_assert(offsetof(TriRecord, bounds) == 0 && sizeof(PixelRect) == 16);
+static_assert(offsetof(TriRecord, blocks) == 16 && offsetof(TriRecord, small) == 24);
+static_assert(sizeof(TriRecord) == 32);
+static_assert(offsetof(RecordEdges, edge) == 0 && sizeof(RecordEdge) == 16 &&
+              offsetof(RecordEdge, b) == 4 && offsetof(RecordEdge, c) == 8);
 static_assert(offsetof(Interpolants, x_ref) == 0 && offsetof(Interpolants, y_ref) == 4);
 static_assert(offsetof(Interpolants, z) == 8 && offsetof(Interpolants, inv_w) == 32);
 static_assert(offsetof(Interpolants, num_varyings) == 44);
@@ -69,16 +70,17 @@ template <int kPick>
 // stored.
 [[gnu::always_inline]] inline void records8(const TriangleLanes& lanes, int h, int num_varyings,
                                             FrontFace front_face, std::byte* const* dest,
-                                            int tiles_x, GroupTiles& tiles) {
-  static_assert(record_bytes(0) >= 40 * 4, "the first five blocks are whole in every record");
+                                            std::byte* const* edges, int tiles_x,
+                                            GroupTiles& tiles) {
+  static_assert(record_bytes(0) >= 16 * 4, "the first two blocks are whole in every record");
   const __m256i one = _mm256_set1_epi32(1);
   __m256i r[8];
-  // Words from 40 first: the varyings' planes but the first (a0, dadx, dady each; var[i][k] is
-  // plane 3 i + k, word 39 + 3 i + k). The last block of a record may reach past its end, into the
-  // next record's first block, which is stored after it.
+  // Words from 24 first: the varyings' planes from the fourth (a0, dadx, dady each; var[i][k] is
+  // plane 3 i + k, word 21 + 3 i + k). The last block of a record may reach past its end, into
+  // the next record's first block or its edges, which are stored after it.
   const float* planes = &lanes.var[0][0][h];
   const int count = 3 * num_varyings;
-  for (int first = 1, block = 5; first < count; first += 8, ++block) {
+  for (int first = 3, block = 3; first < count; first += 8, ++block) {
     if (first + 8 <= count) {
       for (int i = 0; i < 8; ++i) r[i] = row(planes + (first + i) * TriangleLanes::kMaxLanes);
     } else {
@@ -89,53 +91,10 @@ template <int kPick>
     }
     transpose_store(r, dest, block);
   }
-  // Words 0-23: the edges, the bounds, the blocks.
-  r[0] = row(&lanes.edge_a[0][h]);  // EdgeFunction: a and b sign-extended from 32 bits, c
-  r[1] = _mm256_srai_epi32(r[0], 31);
-  r[2] = row(&lanes.edge_b[0][h]);
-  r[3] = _mm256_srai_epi32(r[2], 31);
-  word_rows(&lanes.edge_c[0][h], r[4], r[5]);
-  r[6] = row(&lanes.edge_a[1][h]);
-  r[7] = _mm256_srai_epi32(r[6], 31);
-  transpose_store(r, dest, 0);
-  r[0] = row(&lanes.edge_b[1][h]);
-  r[1] = _mm256_srai_epi32(r[0], 31);
-  word_rows(&lanes.edge_c[1][h], r[2], r[3]);
-  r[4] = row(&lanes.edge_a[2][h]);
-  r[5] = _mm256_srai_epi32(r[4], 31);
-  r[6] = row(&lanes.edge_b[2][h]);
-  r[7] = _mm256_srai_epi32(r[6], 31);
-  transpose_store(r, dest, 1);
-  word_rows(&lanes.edge_c[2][h], r[0], r[1]);
-  for (int i = 0; i < 4; ++i) r[2 + i] = row(&lanes.bounds[i][h]);
-  r[6] = row(&lanes.blocks[0][h]);
-  r[7] = row(&lanes.blocks[1][h]);
-  transpose_store(r, dest, 2);
-  {  // The bins (GroupTiles), from the bounds x0, y0, x1, y1 in r[2..6).
-    static_assert(kTileSize == 1 << 6);
-    const __m256i tx0 = _mm256_srli_epi32(r[2], 6), ty0 = _mm256_srli_epi32(r[3], 6);
-    const __m256i tx1 = _mm256_srli_epi32(_mm256_sub_epi32(r[4], one), 6);
-    const __m256i ty1 = _mm256_srli_epi32(_mm256_sub_epi32(r[5], one), 6);
-    const __m256i one_tile =
-        _mm256_and_si256(_mm256_cmpeq_epi32(tx0, tx1), _mm256_cmpeq_epi32(ty0, ty1));
-    tiles.spans |= (~uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(one_tile))) & 0xffu) << h;
-    _mm256_store_si256(reinterpret_cast<__m256i*>(&tiles.tile[h]),
-                       _mm256_add_epi32(_mm256_mullo_epi32(ty0, _mm256_set1_epi32(tiles_x)), tx0));
-  }
-  // Words 24-31: small (a bool, then the record's padding), the interpolants from x_ref.
-  r[0] = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(lanes.small >> h)),
-                                            _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)),
-                          one);
-  r[1] = _mm256_setzero_si256();
-  r[2] = row(&lanes.x_ref[h]);
-  r[3] = row(&lanes.y_ref[h]);
-  word_rows(&lanes.z[0][h], r[4], r[5]);
-  word_rows(&lanes.z[1][h], r[6], r[7]);
-  transpose_store(r, dest, 3);
-  // Words 32-39: the rest of the fixed fields, the first varying's a0.
-  word_rows(&lanes.z[2][h], r[0], r[1]);
-  for (int k = 0; k < 3; ++k) r[2 + k] = row(&lanes.inv_w[k][h]);
-  r[5] = _mm256_set1_epi32(num_varyings);
+  // Words 16-23: the rest of the fixed fields, the first varying's planes (past the record's end
+  // when it has none: the next record's bytes, stored after).
+  for (int k = 0; k < 3; ++k) r[k] = row(&lanes.inv_w[k][h]);
+  r[3] = _mm256_set1_epi32(num_varyings);
   {  // front_facing (is_front_facing): area < 0 counter-clockwise, area > 0 clockwise.
     const __m256i zero = _mm256_setzero_si256();
     const __m256i a = _mm256_load_si256(reinterpret_cast<const __m256i*>(&lanes.area[h]));
@@ -143,19 +102,62 @@ template <int kPick>
     const bool ccw = front_face == FrontFace::kCounterClockwise;
     const __m256i fa = ccw ? _mm256_cmpgt_epi64(zero, a) : _mm256_cmpgt_epi64(a, zero);
     const __m256i fb = ccw ? _mm256_cmpgt_epi64(zero, b) : _mm256_cmpgt_epi64(b, zero);
-    r[6] = _mm256_and_si256(words_of<0x88>(fa, fb), one);
+    r[4] = _mm256_and_si256(words_of<0x88>(fa, fb), one);
   }
-  r[7] = count > 0 ? row(planes) : _mm256_setzero_si256();
-  transpose_store(r, dest, 4);
+  for (int i = 0; i < 3; ++i) {
+    r[5 + i] = i < count ? row(planes + i * TriangleLanes::kMaxLanes) : _mm256_setzero_si256();
+  }
+  transpose_store(r, dest, 2);
+  // Words 8-15: the interpolants from x_ref.
+  r[0] = row(&lanes.x_ref[h]);
+  r[1] = row(&lanes.y_ref[h]);
+  word_rows(&lanes.z[0][h], r[2], r[3]);
+  word_rows(&lanes.z[1][h], r[4], r[5]);
+  word_rows(&lanes.z[2][h], r[6], r[7]);
+  transpose_store(r, dest, 1);
+  // Words 0-7: the bounds, the blocks, small (a bool, then the header's padding).
+  for (int i = 0; i < 4; ++i) r[i] = row(&lanes.bounds[i][h]);
+  r[4] = row(&lanes.blocks[0][h]);
+  r[5] = row(&lanes.blocks[1][h]);
+  r[6] = _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(int(lanes.small >> h)),
+                                            _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)),
+                          one);
+  r[7] = _mm256_setzero_si256();
+  {  // The bins (GroupTiles), from the bounds x0, y0, x1, y1 in r[0..4).
+    static_assert(kTileSize == 1 << 6);
+    const __m256i tx0 = _mm256_srli_epi32(r[0], 6), ty0 = _mm256_srli_epi32(r[1], 6);
+    const __m256i tx1 = _mm256_srli_epi32(_mm256_sub_epi32(r[2], one), 6);
+    const __m256i ty1 = _mm256_srli_epi32(_mm256_sub_epi32(r[3], one), 6);
+    const __m256i one_tile =
+        _mm256_and_si256(_mm256_cmpeq_epi32(tx0, tx1), _mm256_cmpeq_epi32(ty0, ty1));
+    tiles.spans |= (~uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(one_tile))) & 0xffu) << h;
+    _mm256_store_si256(reinterpret_cast<__m256i*>(&tiles.tile[h]),
+                       _mm256_add_epi32(_mm256_mullo_epi32(ty0, _mm256_set1_epi32(tiles_x)), tx0));
+  }
+  transpose_store(r, dest, 0);
+  // The edges (RecordEdges, before the header; scratch room for the lanes without): a and b, the
+  // low and high words of c, edge by edge, then the padding.
+  for (int k = 0; k < 2; ++k) {
+    r[4 * k] = row(&lanes.edge_a[k][h]);
+    r[4 * k + 1] = row(&lanes.edge_b[k][h]);
+    word_rows(&lanes.edge_c[k][h], r[4 * k + 2], r[4 * k + 3]);
+  }
+  transpose_store(r, edges, 0);
+  r[0] = row(&lanes.edge_a[2][h]);
+  r[1] = row(&lanes.edge_b[2][h]);
+  word_rows(&lanes.edge_c[2][h], r[2], r[3]);
+  for (int i = 4; i < 8; ++i) r[i] = _mm256_setzero_si256();
+  transpose_store(r, edges, 1);
 }
 
 }  // namespace
 
 void write_records(const TriangleLanes& lanes, int count, int num_varyings, FrontFace front_face,
-                   std::byte* const* dest, int tiles_x, GroupTiles& tiles) {
+                   std::byte* const* dest, std::byte* const* edges, int tiles_x,
+                   GroupTiles& tiles) {
   tiles.spans = 0;
   for (int h = 0; h < count; h += 8) {
-    records8(lanes, h, num_varyings, front_face, dest + h, tiles_x, tiles);
+    records8(lanes, h, num_varyings, front_face, dest + h, edges + h, tiles_x, tiles);
   }
 }
 

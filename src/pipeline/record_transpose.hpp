@@ -18,11 +18,13 @@
 
 namespace softrast::detail {
 
-// Lane l's coverage: the record's fields before its interpolants. Precondition: lane l is ready.
+// Lane l's coverage: the record's fields before its interpolants, and its edges (which must have
+// their room: TriRecord). Precondition: lane l is ready.
 inline void write_coverage(const TriangleLanes& lanes, int l, TriRecord* rec) {
-  for (int k = 0; k < 3; ++k) {
-    rec->edge[k] = {lanes.edge_a[k][l], lanes.edge_b[k][l], lanes.edge_c[k][l]};
-  }
+  EdgeFunction edge[3];
+  for (int k = 0; k < 3; ++k)
+    edge[k] = {lanes.edge_a[k][l], lanes.edge_b[k][l], lanes.edge_c[k][l]};
+  rec->set_edges(edge);
   rec->bounds = {lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l], lanes.bounds[3][l]};
   rec->small = (lanes.small >> l) & 1u;
   rec->blocks = lanes.blocks[0][l] | uint64_t(lanes.blocks[1][l]) << 32;
@@ -62,13 +64,15 @@ struct GroupTiles {
 
 // Writes the records of lanes [0, count) (count 8 or 16) as write_coverage and write_planes
 // write them (without the scanline rasterizer's vertices): record_bytes(num_varyings) bytes at
-// dest[l] for lane l, the padding bytes zero, and their bins into `tiles`. The varyings' last
-// blocks are stored first, so records whose dest are in increasing lane order and back to back
-// get the next record's bytes over a record's excess; the last record needs kRecordSlack bytes of
-// room after it. A lane that is not ready, or in scalar_planes, gets bytes of no meaning: point
-// it at scratch room of kMaxTransposedBytes. Preconditions: the CPU has AVX2, num_varyings <=
+// dest[l] for lane l, the padding bytes zero, its edges (sizeof(RecordEdges) bytes) at edges[l],
+// and their bins into `tiles`. The varyings' last blocks are stored first, and the edges last, so
+// records whose edges and dest are in increasing lane order and back to back get the next
+// record's bytes over a record's excess; the last record needs kRecordSlack bytes of room after
+// it. A lane that is not ready, or in scalar_planes, gets bytes of no meaning: point its dest at
+// scratch room of kMaxTransposedBytes, and its edges there too, as those of a lane whose record
+// goes without (a speck's: TriRecord). Preconditions: the CPU has AVX2, num_varyings <=
 // kMaxTransposedVaryings.
 void write_records(const TriangleLanes& lanes, int count, int num_varyings, FrontFace front_face,
-                   std::byte* const* dest, int tiles_x, GroupTiles& tiles);
+                   std::byte* const* dest, std::byte* const* edges, int tiles_x, GroupTiles& tiles);
 
 }  // namespace softrast::detail

@@ -46,7 +46,7 @@ template <class V, class T>
     I p = pixel_index(g);
     V column = __builtin_convertvector(p & 3, V), row = __builtin_convertvector(p >> 2, V);
     for (int k = 0; k < 3; ++k) {
-      o.off[k][g] = T(t.edge[k].a * kSubpixelOne) * column + T(t.edge[k].b * kSubpixelOne) * row;
+      o.off[k][g] = T(t.edge(k).a * kSubpixelOne) * column + T(t.edge(k).b * kSubpixelOne) * row;
     }
   }
 }
@@ -346,7 +346,7 @@ struct EdgeExtents {
   EdgeExtents x{};
   int64_t span = int64_t(size - 1) * kSubpixelOne;
   for (int k = 0; k < 3; ++k) {
-    int64_t ax = t.edge[k].a * span, by = t.edge[k].b * span;
+    int64_t ax = t.edge(k).a * span, by = t.edge(k).b * span;
     x.lo[k] = std::min<int64_t>(ax, 0) + std::min<int64_t>(by, 0);
     x.hi[k] = std::max<int64_t>(ax, 0) + std::max<int64_t>(by, 0);
   }
@@ -445,8 +445,8 @@ template <class Emit, class Region, class Partial>
   U column[3][kGroups];           // E's change from the row's first block to the lane's block
   uint32_t step[3], row_step[3];  // E's change to the next block right, and down
   for (int k = 0; k < 3; ++k) {
-    step[k] = uint32_t(t.edge[k].a * (kSubpixelOne * kBlockSize));
-    row_step[k] = uint32_t(t.edge[k].b * (kSubpixelOne * kBlockSize));
+    step[k] = uint32_t(t.edge(k).a * (kSubpixelOne * kBlockSize));
+    row_step[k] = uint32_t(t.edge(k).b * (kSubpixelOne * kBlockSize));
     for (int g = 0; g < kGroups; ++g) column[k][g] = U(pixel_index(g)) * step[k];
   }
   const int bx0 = area.x0 & ~(kBlockSize - 1), by0 = area.y0 & ~(kBlockSize - 1);
@@ -644,9 +644,9 @@ template <Mode kMode>
   grid.x0 = area.x0 & ~(kBlockSize - 1);
   grid.y0 = area.y0 & ~(kBlockSize - 1);
   for (int k = 0; k < 3; ++k) {
-    grid.origin[k] = t.edge[k].at(sample_fx8(grid.x0), sample_fx8(grid.y0));
-    grid.step_x[k] = t.edge[k].a * kSubpixelOne;
-    grid.step_y[k] = t.edge[k].b * kSubpixelOne;
+    grid.origin[k] = t.edge(k).at(sample_fx8(grid.x0), sample_fx8(grid.y0));
+    grid.step_x[k] = t.edge(k).a * kSubpixelOne;
+    grid.step_y[k] = t.edge(k).b * kSubpixelOne;
   }
   if (rec.small && area.x1 - grid.x0 <= kBlockSize && area.y1 - grid.y0 <= kBlockSize) {
     // Inside one block (the usual triangle of a dense mesh): that block's coverage, nothing else.
@@ -667,12 +667,13 @@ template <Mode kMode>
 // Asks the cache for the record kRecordPrefetchAhead places on in the bin: a batch's records
 // outgrow the L2 cache, and a tile reads its own among those of its neighbours, so each was a miss
 // to L3 when the raster reached it (spheres_1m: a sixth of the tile kernel's time on the record's
-// first load). Four lines: the coverage and the first planes (a record of three varyings is 192
-// bytes, of phong's six 232; a fifth line for phong's measured the same). Eight records ahead
+// first load). Four lines: the edges before the header (TriRecord; for a speck, the end of the
+// record before it, usually one the tile has just read), the header and the first planes (a
+// record of three varyings is 120 bytes from its header, of phong's six 160). Eight records ahead
 // measured the same as four on a Zen 5 (spheres_1m, one thread).
 constexpr size_t kRecordPrefetchAhead = 4;
 [[gnu::always_inline]] inline void prefetch_record(const std::byte* record) {
-  for (int line = 0; line < 4; ++line) {
+  for (int line = -1; line < 3; ++line) {
     prefetch_line(record + 64 * line);
   }
 }
