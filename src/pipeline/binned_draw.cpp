@@ -340,16 +340,19 @@ class BinnedDraw {
   // The records of a group whose ready lanes are all set up by the kernel, planes included, in
   // one stretch of the arena, in lane order; then their places in the bins.
   void add_group(Chunk& chunk, const TriangleLanes& lanes, int width, std::byte* scratch) {
-    int count = 0;
-    for (uint32_t m = lanes.ready; m != 0; m &= m - 1) ++count;
-    // The specks whose blocks the kernel found go without edges (TriRecord).
+    // The records, and the edges of those that have them: the specks whose blocks the kernel
+    // found go without (TriRecord). (Counted by loops: this file is built for the baseline, where
+    // __builtin_popcount is a call into libgcc.)
     uint32_t with_edges = 0;
-    for (int l = 0; l < width; ++l) {
-      with_edges |= uint32_t((lanes.blocks[0][l] | lanes.blocks[1][l]) == 0) << l;
+    size_t count = 0, edge_count = 0;
+    for (uint32_t m = lanes.ready; m != 0; m &= m - 1) {
+      const int l = __builtin_ctz(m);
+      const bool edges = (lanes.blocks[0][l] | lanes.blocks[1][l]) == 0;
+      with_edges |= uint32_t(edges) << l;
+      ++count;
+      edge_count += edges;
     }
-    with_edges &= lanes.ready;
-    const size_t bytes = size_t(count) * record_bytes_ +
-                         size_t(__builtin_popcount(with_edges)) * sizeof(RecordEdges);
+    const size_t bytes = count * record_bytes_ + edge_count * sizeof(RecordEdges);
     const uint32_t first = chunk.records.allocate(bytes, kRecordSlack);
     std::byte* const data = reinterpret_cast<std::byte*>(chunk.records.at(first));
     std::byte* dest[TriangleLanes::kMaxLanes];

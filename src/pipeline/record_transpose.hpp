@@ -22,8 +22,9 @@ namespace softrast::detail {
 // their room: TriRecord). Precondition: lane l is ready.
 inline void write_coverage(const TriangleLanes& lanes, int l, TriRecord* rec) {
   EdgeFunction edge[3];
-  for (int k = 0; k < 3; ++k)
+  for (int k = 0; k < 3; ++k) {
     edge[k] = {lanes.edge_a[k][l], lanes.edge_b[k][l], lanes.edge_c[k][l]};
+  }
   rec->set_edges(edge);
   rec->bounds = {lanes.bounds[0][l], lanes.bounds[1][l], lanes.bounds[2][l], lanes.bounds[3][l]};
   rec->small = (lanes.small >> l) & 1u;
