@@ -136,7 +136,11 @@ template <int kPick>
   }
   transpose_store(r, dest, 0);
   // The edges (RecordEdges, before the header; scratch room for the lanes without): a and b, the
-  // low and high words of c, edge by edge, then the padding.
+  // low and high words of c, edge by edge, then the padding. Not at all where every lane has
+  // blocks (a speck's record goes without; a lane that is not ready has no record): on a dense
+  // mesh, most groups of eight.
+  const __m256i no_blocks = _mm256_cmpeq_epi32(_mm256_or_si256(r[4], r[5]), _mm256_setzero_si256());
+  if (_mm256_testz_si256(no_blocks, no_blocks)) return;
   for (int k = 0; k < 2; ++k) {
     r[4 * k] = row(&lanes.edge_a[k][h]);
     r[4 * k + 1] = row(&lanes.edge_b[k][h]);

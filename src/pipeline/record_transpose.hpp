@@ -65,13 +65,14 @@ struct GroupTiles {
 
 // Writes the records of lanes [0, count) (count 8 or 16) as write_coverage and write_planes
 // write them (without the scanline rasterizer's vertices): record_bytes(num_varyings) bytes at
-// dest[l] for lane l, the padding bytes zero, its edges (sizeof(RecordEdges) bytes) at edges[l],
-// and their bins into `tiles`. The varyings' last blocks are stored first, and the edges last, so
-// records whose edges and dest are in increasing lane order and back to back get the next
-// record's bytes over a record's excess; the last record needs kRecordSlack bytes of room after
-// it. A lane that is not ready, or in scalar_planes, gets bytes of no meaning: point its dest at
-// scratch room of kMaxTransposedBytes, and its edges there too, as those of a lane whose record
-// goes without (a speck's: TriRecord). Preconditions: the CPU has AVX2, num_varyings <=
+// dest[l] for lane l, the padding bytes zero; the edges (sizeof(RecordEdges) bytes) of each lane
+// whose blocks are 0 at edges[l] (other lanes' edges[l] may be written or not); and their bins
+// into `tiles`. The varyings' last blocks are stored first, and the edges last, so records whose
+// edges and dest are in increasing lane order and back to back get the next record's bytes over
+// a record's excess; the last record needs kRecordSlack bytes of room after it. A lane that is
+// not ready, or in scalar_planes, gets bytes of no meaning: point its dest at scratch room of
+// kMaxTransposedBytes, and its edges there too, as those of a lane whose record goes without (a
+// speck's: TriRecord). Preconditions: the CPU has AVX2, num_varyings <=
 // kMaxTransposedVaryings.
 void write_records(const TriangleLanes& lanes, int count, int num_varyings, FrontFace front_face,
                    std::byte* const* dest, std::byte* const* edges, int tiles_x, GroupTiles& tiles);
