@@ -137,8 +137,10 @@ template <int kPick>
   transpose_store(r, dest, 0);
   // The edges (RecordEdges, before the header; scratch room for the lanes without): a and b, the
   // low and high words of c, edge by edge, then the padding. Not at all where every lane has
-  // blocks (a speck's record goes without; a lane that is not ready has no record): on a dense
-  // mesh, most groups of eight.
+  // blocks (a speck's record goes without): on a dense mesh, most groups of eight. A lane that is
+  // not ready (culled, or a speck covering no pixel) has no blocks, so it keeps the stores for its
+  // group; leaving such lanes out too (their bits of lanes.ready) measured the same (spheres_1m
+  // gouraud and phong, one thread, 36.95 / 36.77 and 47.81 / 47.86 ms).
   const __m256i no_blocks = _mm256_cmpeq_epi32(_mm256_or_si256(r[4], r[5]), _mm256_setzero_si256());
   if (_mm256_testz_si256(no_blocks, no_blocks)) return;
   for (int k = 0; k < 2; ++k) {
